@@ -1,0 +1,1 @@
+"""Pseudo-arclength continuation on any callable ``x -> (R, dR/dx)``; knows nothing of HBM."""

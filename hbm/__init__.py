@@ -1,0 +1,1 @@
+"""Multi-harmonic balance (AFT) solver for structures damped by dry friction."""

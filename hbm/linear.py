@@ -1,0 +1,164 @@
+r"""Linear model and its dynamic stiffness, stored per harmonic (never as a Kronecker product).
+
+For ``M q'' + C q' + K q`` and the real Fourier layout of :mod:`hbm.fourier`, harmonic ``h``
+contributes the block
+
+.. math::
+
+    Z_0 = K, \qquad
+    Z_h(w) = \begin{bmatrix} K - (h w)^2 M & h w C \\ -h w C & K - (h w)^2 M \end{bmatrix}
+
+acting on ``[Xc_h, Xs_h]``, with ``dZ_h/dw = [[-2 h^2 w M, h C], [-h C, -2 h^2 w M]]``.
+Damping is a viscous matrix, a Rayleigh pair ``C = a M + b K``, or modal damping ratios
+``C = M Phi diag(2 zeta_r omega_r) Phi^T M`` (mass-normalised modes ``Phi``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from .fourier import FourierBasis
+
+
+def _square(name, A, n=None):
+    A = np.asarray(A, dtype=float)
+    if A.ndim != 2 or A.shape[0] != A.shape[1]:
+        raise ValueError(f"{name} must be a square matrix, got shape {A.shape}")
+    if n is not None and A.shape[0] != n:
+        raise ValueError(f"{name} must be {n}x{n} like the mass matrix, got {A.shape}")
+    if not np.all(np.isfinite(A)):
+        raise ValueError(f"{name} has non-finite entries")
+    return A
+
+
+def _symmetric(name, A):
+    tol = 1e-10 * max(1.0, np.abs(A).max())
+    if np.abs(A - A.T).max() > tol:
+        raise ValueError(f"{name} must be symmetric")
+
+
+def modal_damping_matrix(M, K, zeta) -> np.ndarray:
+    """``C = M Phi diag(2 zeta_r omega_r) Phi^T M`` for ratios ``zeta`` (scalar or (n,))."""
+    lam, Phi = sla.eigh(K, M)
+    om = np.sqrt(np.clip(lam, 0.0, None))
+    z = np.broadcast_to(np.asarray(zeta, dtype=float), om.shape)
+    MPhi = M @ Phi
+    return (MPhi * (2.0 * z * om)) @ MPhi.T
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """Mass, damping and stiffness matrices of the linear structure, shape (n, n) each.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Symmetric; ``M`` positive definite, ``K`` positive semi-definite.
+    dof_names : tuple of str, optional
+        Names of the DOFs (for case files that name DOFs).
+    """
+
+    M: np.ndarray
+    C: np.ndarray
+    K: np.ndarray
+    dof_names: tuple = ()
+    _dof_index: dict = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        M = _square("mass", self.M)
+        n = M.shape[0]
+        K = _square("stiffness", self.K, n)
+        C = _square("damping", self.C, n)
+        for name, A in (("mass", M), ("stiffness", K), ("damping", C)):
+            _symmetric(name, A)
+        try:
+            np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            raise ValueError("mass matrix must be positive definite (non-positive mass?)") from None
+        kmin = np.linalg.eigvalsh(K).min() if n else 0.0
+        if kmin < -1e-9 * max(1.0, np.abs(K).max()):
+            raise ValueError("stiffness matrix must be positive semi-definite (negative stiffness?)")
+        cmin = np.linalg.eigvalsh(C).min() if n else 0.0
+        if cmin < -1e-9 * max(1.0, np.abs(C).max()):
+            raise ValueError("damping matrix must be positive semi-definite (negative damping?)")
+        names = tuple(self.dof_names)
+        if names and len(names) != n:
+            raise ValueError(f"dof_names has {len(names)} names for {n} DOFs")
+        for A in (M, C, K):
+            A.setflags(write=False)
+        object.__setattr__(self, "M", M)
+        object.__setattr__(self, "C", C)
+        object.__setattr__(self, "K", K)
+        object.__setattr__(self, "dof_names", names)
+        object.__setattr__(self, "_dof_index", {s: i for i, s in enumerate(names)})
+
+    @classmethod
+    def with_damping(cls, M, K, *, damping=None, rayleigh=None, modal_damping=None, dof_names=()):
+        """Build from M, K and exactly one of a viscous matrix, a Rayleigh pair or modal ratios."""
+        M = _square("mass", M)
+        K = _square("stiffness", K, M.shape[0])
+        given = [x is not None for x in (damping, rayleigh, modal_damping)]
+        if sum(given) > 1:
+            raise ValueError("give only one of damping, rayleigh, modal_damping")
+        if damping is not None:
+            C = _square("damping", damping, M.shape[0])
+        elif rayleigh is not None:
+            a = np.asarray(rayleigh, dtype=float)
+            if a.shape != (2,):
+                raise ValueError("rayleigh must be a pair [a, b] (C = a M + b K)")
+            C = a[0] * M + a[1] * K
+        elif modal_damping is not None:
+            z = np.asarray(modal_damping, dtype=float)
+            if np.any(z < 0):
+                raise ValueError("modal_damping ratios must be >= 0")
+            if z.ndim > 1 or (z.ndim == 1 and z.size != M.shape[0]):
+                raise ValueError(f"modal_damping must be a number or a list of {M.shape[0]} ratios")
+            _symmetric("mass", M)
+            _symmetric("stiffness", K)
+            C = modal_damping_matrix(M, K, z)
+        else:
+            C = np.zeros_like(M)
+        return cls(M, C, K, tuple(dof_names))
+
+    @property
+    def n_dof(self) -> int:
+        return self.M.shape[0]
+
+    @property
+    def dof_index(self) -> dict:
+        return self._dof_index
+
+    def natural_frequencies_hz(self) -> np.ndarray:
+        """Undamped natural frequencies in Hz, ascending."""
+        lam = sla.eigh(self.K, self.M, eigvals_only=True)
+        return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
+
+
+def harmonic_blocks(model: LinearModel, basis: FourierBasis, w: float):
+    """Per-harmonic dynamic stiffness blocks and their w-derivatives.
+
+    Returns
+    -------
+    blocks : list of ndarray
+        One block per harmonic of ``basis.harmonics``: (n, n) for h = 0, (2n, 2n) otherwise,
+        acting on that harmonic's rows of the unknown vector.
+    dblocks : list of ndarray
+        ``dZ_h/dw``, same shapes.
+    """
+    M, C, K = model.M, model.C, model.K
+    blocks, dblocks = [], []
+    for h in basis.harmonics:
+        if h == 0:
+            blocks.append(K.copy())
+            dblocks.append(np.zeros_like(K))
+            continue
+        hw = h * w
+        A = K - hw * hw * M
+        B = hw * C
+        blocks.append(np.block([[A, B], [-B, A]]))
+        dA = -2.0 * h * hw * M
+        dB = h * C
+        dblocks.append(np.block([[dA, dB], [-dB, dA]]))
+    return blocks, dblocks
