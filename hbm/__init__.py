@@ -1,1 +1,17 @@
-"""Multi-harmonic balance (AFT) solver for structures damped by dry friction."""
+"""Multi-harmonic balance (AFT) solver for structures damped by dry friction.
+
+>>> import hbm
+>>> case = hbm.load_case("rigs/sdof_jenkins.toml")
+>>> res = hbm.frf(case, harmonics=7)
+>>> res.freq_hz, res.outputs["x"].h1
+"""
+from .case import Case, CaseError, load_case
+
+
+def frf(case, harmonics=None, samples=None, fmin=None, fmax=None, **kwargs):
+    """Trace the FRF of a case; see :func:`hbm.frf.frf`."""
+    from .frf import frf as _frf
+    return _frf(case, harmonics=harmonics, samples=samples, fmin=fmin, fmax=fmax, **kwargs)
+
+
+__all__ = ["Case", "CaseError", "load_case", "frf"]

@@ -1,0 +1,48 @@
+r"""Energy balance over one period of a harmonic-balance solution.
+
+With velocity coefficients :math:`V = w D X` (:mod:`hbm.fourier`) and period :math:`T = 2\pi/w`,
+the work of a periodic force ``F`` on the velocity over one period is (Parseval)
+
+.. math::
+
+    W[F] = \int_0^T F \cdot \dot q \, dt = \frac{T}{2} \sum_{r:\,h_r > 0} F_r \cdot V_r .
+
+At a converged point the excitation's work equals the viscous plus the friction dissipation,
+:math:`W[F_{ex}] = \frac{T}{2}\sum_r V_r^T C V_r + W[F_{nl}]` (stiffness and mass forces do
+no work over a period).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class EnergyBalance:
+    """Work per period (J): excitation input, viscous and nonlinear dissipation, relative error."""
+
+    excitation: float
+    viscous: float
+    nonlinear: float
+
+    @property
+    def relative_error(self) -> float:
+        ref = max(abs(self.excitation), abs(self.viscous) + abs(self.nonlinear), 1e-300)
+        return abs(self.excitation - self.viscous - self.nonlinear) / ref
+
+
+def work(basis, F: np.ndarray, V: np.ndarray, w: float) -> float:
+    """Work per period of forces ``F`` (n_coef, n) on velocities ``V`` (n_coef, n)."""
+    mask = basis.h_of_row > 0
+    return float(np.pi / w * np.sum(F[mask] * V[mask]))
+
+
+def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
+    """Energy balance of ``problem`` (a :class:`hbm.residual.HarmonicBalance`) at ``(X, w)``."""
+    basis = problem.basis
+    V = w * (basis.D @ X)
+    w_ex = work(basis, problem.Fex, V, w)
+    w_visc = work(basis, V @ problem.model.C, V, w)
+    w_nl = work(basis, problem.nonlinear_forces(X, w), V, w)
+    return EnergyBalance(w_ex, w_visc, w_nl)

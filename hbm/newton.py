@@ -1,0 +1,78 @@
+r"""Damped Newton solver with the exact Jacobian, unknown scaling and a backtracking line search.
+
+Solves ``R(x) = 0`` for a square system.  With the diagonal scaling ``x = S y`` the step is
+
+.. math::
+
+    \Delta y = -(J S)^{-1} R, \qquad x \leftarrow x + \alpha S \Delta y,
+
+with ``alpha`` halved until ``||R||`` decreases (Armijo-like), and convergence when
+``||R|| <= tol * r_scale`` and the scaled step is small.  The result always carries a status
+and a message: it never fails silently.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class NewtonResult:
+    """Outcome of :func:`newton`: ``x``, ``converged``, ``iterations``, ``residual``, ``message``."""
+
+    x: np.ndarray
+    converged: bool
+    iterations: int
+    residual: float
+    message: str
+
+
+def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30) -> NewtonResult:
+    """Solve ``fun(x) = (R, J) -> R = 0``.
+
+    Parameters
+    ----------
+    fun : callable
+        ``x (n,) -> (R (n,), J (n, n))``.
+    x0 : ndarray, shape (n,)
+        Initial guess.
+    scale : ndarray, shape (n,), optional
+        Typical magnitude of each unknown (default 1).
+    r_scale : float
+        Typical magnitude of the residual (e.g. the force amplitude).
+    tol : float
+        Relative residual tolerance.
+    max_iter : int
+
+    Returns
+    -------
+    NewtonResult
+    """
+    x = np.array(x0, dtype=float)
+    S = np.ones_like(x) if scale is None else np.asarray(scale, dtype=float)
+    R, J = fun(x)
+    r = float(np.linalg.norm(R))
+    target = tol * max(r_scale, 1e-300)
+    for it in range(1, max_iter + 1):
+        if not np.all(np.isfinite(R)):
+            return NewtonResult(x, False, it - 1, np.inf, "residual is not finite")
+        if r <= target:
+            return NewtonResult(x, True, it - 1, r, "converged")
+        try:
+            dy = np.linalg.solve(J * S, -R)
+        except np.linalg.LinAlgError:
+            return NewtonResult(x, False, it - 1, r, "singular Jacobian")
+        alpha = 1.0
+        while True:
+            xt = x + alpha * S * dy
+            Rt, Jt = fun(xt)
+            rt = float(np.linalg.norm(Rt))
+            if np.isfinite(rt) and (rt < r or alpha < 1.0 / 64):
+                break
+            alpha *= 0.5
+        x, R, J, r = xt, Rt, Jt, rt
+    if r <= target:
+        return NewtonResult(x, True, max_iter, r, "converged")
+    return NewtonResult(x, False, max_iter, r,
+                        f"no convergence in {max_iter} iterations (residual {r:.3g}, target {target:.3g})")

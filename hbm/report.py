@@ -1,0 +1,96 @@
+"""Write an FRF to disk: ``frf.csv``, ``summary.json`` and ``frf.png`` (CLI contract of DESIGN.md).
+
+``frf.csv`` columns: ``freq_hz``, then ``NAME_h1`` and ``NAME_max`` per output, then ``stable``
+(1/0, empty when not computed); rows follow the continuation path.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+
+def peaks(freq: np.ndarray, amp: np.ndarray) -> list:
+    """Local maxima of ``amp`` along the path: ``[{"freq_hz": f, "amplitude": a}, ...]``."""
+    out = []
+    n = amp.size
+    for i in range(n):
+        left = amp[i - 1] if i > 0 else -np.inf
+        right = amp[i + 1] if i < n - 1 else -np.inf
+        if amp[i] > left and amp[i] >= right and 0 < i < n - 1:
+            out.append({"freq_hz": float(freq[i]), "amplitude": float(amp[i])})
+    if not out and n:
+        i = int(np.argmax(amp))
+        out.append({"freq_hz": float(freq[i]), "amplitude": float(amp[i])})
+    return out
+
+
+def write_csv(res, path: Path) -> None:
+    names = list(res.outputs)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")] + ["stable"])
+        for i, f in enumerate(res.freq_hz):
+            row = [f"{f:.10g}"]
+            for n in names:
+                o = res.outputs[n]
+                row += [f"{o.h1[i]:.10g}", f"{o.max[i]:.10g}"]
+            row.append("" if res.stable is None else str(int(bool(res.stable[i]))))
+            w.writerow(row)
+
+
+def summary_dict(case, res, extra=None) -> dict:
+    d = {
+        "case": case.name,
+        "case_file": case.path,
+        "status": res.status,
+        "message": res.message,
+        "settings": res.settings,
+        "n_points": int(res.freq_hz.size),
+        "newton_iterations": int(res.iterations.sum()) if res.iterations.size else 0,
+        "rejected_steps": int(res.n_rejected),
+        "failures": 0 if res.ok else 1,
+        "solve_seconds": round(float(res.solve_seconds), 6),
+        "peaks": {n: peaks(res.freq_hz, o.h1) for n, o in res.outputs.items()},
+        "folds": [float(f) for f in res.folds_hz],
+        "max_energy_error": float(res.energy_error.max()) if res.energy_error.size else None,
+        "elements": [{"name": e.name, "type": type(e).__name__} for e in case.elements],
+    }
+    if extra:
+        d.update(extra)
+    return d
+
+
+def write_plot(res, path: Path, title: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for name, o in res.outputs.items():
+        line, = ax.plot(res.freq_hz, o.h1, label=f"{name} (1st harmonic)")
+        ax.plot(res.freq_hz, o.max, "--", color=line.get_color(), lw=0.8, label=f"{name} (max |x|)")
+    for f in res.folds_hz:
+        ax.axvline(f, color="0.6", lw=0.6, ls=":")
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("amplitude")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def write_frf(case, res, outdir, extra=None) -> dict:
+    """Write the three files into ``outdir`` (created); returns the summary dict."""
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv(res, out / "frf.csv")
+    summary = summary_dict(case, res, extra)
+    with open(out / "summary.json", "w") as fh:
+        json.dump(summary, fh, indent=2)
+    if res.freq_hz.size:
+        write_plot(res, out / "frf.png", case.name)
+    return summary

@@ -1,0 +1,129 @@
+r"""Harmonic-balance residual and its exact Jacobian, composed from its parts.
+
+.. math::
+
+    R(X, w) = Z(w) X + F_{nl}(X, w) - F_{ex}, \qquad
+    \frac{\partial R}{\partial X} = Z(w) + \frac{\partial F_{nl}}{\partial X}, \qquad
+    \frac{\partial R}{\partial w} = Z'(w) X + \frac{\partial F_{nl}}{\partial w}
+
+``X`` has shape (n_coef, n) (harmonic-major, :mod:`hbm.fourier`); ``Z`` is applied block by
+block per harmonic (:func:`hbm.linear.harmonic_blocks`); ``F_ex`` is a cosine force at the
+first harmonic.  The continuation works on ``x = [X.ravel(), w]``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .aft import NonlinearForces
+from .fourier import FourierBasis
+from .linear import LinearModel, harmonic_blocks
+
+
+class HarmonicBalance:
+    """Residual ``R(X, w)`` of a linear model with nonlinear elements and a harmonic force.
+
+    Parameters
+    ----------
+    model : LinearModel
+    elements : sequence of Element
+    basis : FourierBasis
+        Must contain harmonic 1 (the excitation's).
+    force : ndarray, shape (n,)
+        Amplitude of the cosine excitation at the first harmonic, per DOF.
+    transform : object
+        AFT transform built on ``basis``.
+    """
+
+    def __init__(self, model: LinearModel, elements, basis: FourierBasis, force, transform):
+        if 1 not in basis.harmonics:
+            raise ValueError("the harmonic list must contain harmonic 1 (the excitation's)")
+        self.model = model
+        self.basis = basis
+        n = model.n_dof
+        self.n_dof = n
+        self.nl = NonlinearForces(basis, elements, n, transform)
+        Fex = np.zeros((basis.n_coef, n))
+        Fex[basis.row_of(1, "c")] = np.asarray(force, dtype=float)
+        self.Fex = Fex
+        # row slices of each harmonic's block in the flat unknown vector
+        self._slices = []
+        r = 0
+        for h in basis.harmonics:
+            nr = 1 if h == 0 else 2
+            self._slices.append(slice(r * n, (r + nr) * n))
+            r += nr
+        idx = (np.arange(basis.n_coef)[:, None] * n + self.nl.dofs[None, :]).ravel()
+        self._nl_index = idx
+
+    @property
+    def n_unknowns(self) -> int:
+        return self.basis.n_coef * self.n_dof
+
+    def linear_part(self, X: np.ndarray, w: float):
+        """``Z(w) X`` (n_coef, n), ``Z(w)`` dense (n_u, n_u) and ``Z'(w) X`` (n_coef, n)."""
+        blocks, dblocks = harmonic_blocks(self.model, self.basis, w)
+        x = X.reshape(-1)
+        ZX = np.empty_like(x)
+        dZX = np.empty_like(x)
+        Z = np.zeros((x.size, x.size))
+        for s, B, dB in zip(self._slices, blocks, dblocks):
+            ZX[s] = B @ x[s]
+            dZX[s] = dB @ x[s]
+            Z[s, s] = B
+        return ZX.reshape(X.shape), Z, dZX.reshape(X.shape)
+
+    def residual(self, X: np.ndarray, w: float):
+        """Residual and Jacobians.
+
+        Parameters
+        ----------
+        X : ndarray, shape (n_coef, n)
+        w : float
+
+        Returns
+        -------
+        R : ndarray, shape (n_u,)
+        dRdX : ndarray, shape (n_u, n_u)
+        dRdw : ndarray, shape (n_u,)
+        """
+        ZX, J, dZX = self.linear_part(X, w)
+        R = ZX - self.Fex
+        dRdw = dZX
+        if self.nl.n_nl:
+            F, dF, dFw = self.nl.evaluate(np.ascontiguousarray(X[:, self.nl.dofs]), w)
+            R[:, self.nl.dofs] += F
+            dRdw[:, self.nl.dofs] += dFw
+            J[np.ix_(self._nl_index, self._nl_index)] += dF
+        return R.reshape(-1), J, dRdw.reshape(-1)
+
+    def __call__(self, x: np.ndarray):
+        """Continuation form: ``x = [X.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]`` (n_u, n_u + 1)."""
+        X = x[:-1].reshape(self.basis.n_coef, self.n_dof)
+        R, J, dw = self.residual(X, float(x[-1]))
+        return R, np.hstack([J, dw[:, None]])
+
+    def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
+        """``F_nl`` on all DOFs, (n_coef, n)."""
+        F = np.zeros_like(X)
+        if self.nl.n_nl:
+            F[:, self.nl.dofs] = self.nl.forces(np.ascontiguousarray(X[:, self.nl.dofs]), w)
+        return F
+
+    def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
+        """Solution of ``(Z(w) + K_extra) X = F_ex`` (n_coef, n): the start of Newton.
+
+        ``extra_stiffness`` (n, n) adds e.g. the stuck stiffness of the elements.
+        """
+        blocks, _ = harmonic_blocks(self.model, self.basis, w)
+        X = np.zeros_like(self.Fex)
+        f = self.Fex.reshape(-1)
+        x = X.reshape(-1)
+        n = self.n_dof
+        for h, s, B in zip(self.basis.harmonics, self._slices, blocks):
+            if extra_stiffness is not None:
+                B = B.copy()
+                for k in range(B.shape[0] // n):
+                    B[k * n:(k + 1) * n, k * n:(k + 1) * n] += extra_stiffness
+            if np.any(f[s]):
+                x[s] = np.linalg.solve(B, f[s])
+        return X
