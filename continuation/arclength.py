@@ -41,7 +41,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from .corrector import Correction, Evaluation, correct
+from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
 from .options import ArclengthOptions
 from .point import ContinuationPoint
 from .tangent import fold_parameter, null_tangent
@@ -161,16 +161,19 @@ class Arclength:
                                  f"got {R.shape} and {J.shape}")
             return Evaluation(xs.copy(), R, J * self.scale[None, :])
 
-    def _correct(self, xs0, a, b) -> Correction:
+    def _correct(self, xs0, constraint) -> Correction:
         o = self.options
-        return correct(self._evaluate, xs0, a, b, self._rho0, o.tol, o.max_iter, o.max_backtrack)
+        return correct(self._evaluate, xs0, constraint, self._rho0, o.tol, o.max_iter,
+                       o.max_backtrack)
 
     def _fixed_lam(self, xs0: np.ndarray, lam_s: float) -> Correction:
         e = np.zeros_like(xs0)
         e[-1] = 1.0
         start = xs0.copy()
         start[-1] = lam_s
-        return self._correct(start, e, lam_s)
+        c = self._correct(start, linear_constraint(e, lam_s))
+        c.xs[-1] = lam_s  # exactly on the requested value despite round-off in the update
+        return c
 
     # ------------------------------------------------------------------ iteration
     def __iter__(self) -> Iterator[ContinuationPoint]:
@@ -185,7 +188,7 @@ class Arclength:
         return list(self)
 
     def _point(self, c: Correction, t, ds, fold, on_bound=False) -> ContinuationPoint:
-        pt = ContinuationPoint(x=c.ev.xs * self.scale, tangent=t.copy(), iterations=c.iterations,
+        pt = ContinuationPoint(x=c.xs * self.scale, tangent=t.copy(), iterations=c.iterations,
                                ds=float(ds), fold=bool(fold), residual_norm=float(c.residual),
                                on_bound=on_bound)
         self.points.append(pt)
@@ -210,14 +213,13 @@ class Arclength:
         if t[-1] * self.direction < 0:
             t = -t
         yield self._point(c, t, 0.0, False, on_bound=xs[-1] in (lo_s, hi_s))
-        xs = c.ev.xs
+        xs = c.xs
         lam_prev_sign = np.sign(t[-1])
 
         ds = self.ds0
         steps = 0
         consecutive = 0
         angle_reject = None   # (ds, angle) of the last rejection for the angle
-        max_angle = math.radians(o.max_angle_deg)
         while True:
             if steps >= o.max_steps:
                 self.status = "max_steps"
@@ -229,55 +231,20 @@ class Arclength:
                 self.message = f"parameter reached the bound lam={xs[-1] * s_lam:.6g}"
                 return
 
-            pred = xs + ds * t
-            on_bound = False
-            bound = hi_s if pred[-1] > hi_s else lo_s if pred[-1] < lo_s else None
-            if bound is not None:
-                start = xs + ((bound - xs[-1]) / (pred[-1] - xs[-1])) * (pred - xs)
-                c = self._fixed_lam(start, bound)
-                on_bound = True
-            else:
-                c = self._correct(pred, t, float(t @ pred))
-                if c.converged and not lo_s <= c.ev.xs[-1] <= hi_s:
-                    bound = hi_s if c.ev.xs[-1] > hi_s else lo_s
-                    new = c.ev.xs
-                    start = xs + ((bound - xs[-1]) / (new[-1] - xs[-1])) * (new - xs)
-                    c = self._fixed_lam(start, bound)
-                    on_bound = True
-
-            reason = None
-            t_new = None
-            angle = 0.0
-            if not c.converged:
-                reason = f"Newton did not converge ({c.reason})"
-            else:
-                chord = c.ev.xs - xs
-                along = float(chord @ t)
-                jump = float(np.linalg.norm(c.ev.xs - (start if on_bound else pred)))
-                if along <= 0:
-                    reason = "the corrector went back along the path"
-                elif jump > o.max_correction * ds and not on_bound:
-                    reason = f"the corrector moved {jump / ds:.2g} step lengths (branch jump)"
-                else:
-                    t_new = null_tangent(c.ev.Js, t)
-                    if t_new @ chord < 0:
-                        t_new = -t_new
-                    cosang = float(np.clip(t_new @ t, -1.0, 1.0))
-                    angle = math.acos(cosang)
-                    if cosang <= 0:
-                        reason = "the tangent reversed"
-                    elif angle > max_angle:
-                        kink = (angle_reject is not None and angle_reject[0] > ds
-                                and angle > 0.7 * angle_reject[1])
-                        if not kink and 0.5 * ds >= self.ds_min:
-                            reason = (f"the tangent turned {math.degrees(angle):.1f} deg "
-                                      f"> max_angle_deg={o.max_angle_deg:g}")
-                            angle_reject = (ds, angle)
+            c, t_new, angle, reason, on_bound = self._step(xs, t, ds, angle_reject, False)
+            if reason is not None and consecutive >= 1 and not on_bound:
+                # repeated trouble at this point: maybe a sharp corner of the path, which a
+                # hyperplane normal to t cannot cross; try a sphere around the last point
+                c2, t2, a2, r2, b2 = self._step(xs, t, ds, angle_reject, True)
+                if r2 is None or r2.startswith("the tangent turned"):
+                    c, t_new, angle, reason, on_bound = c2, t2, a2, r2, b2
 
             if reason is not None:
                 self.n_rejected += 1
                 consecutive += 1
-                if not reason.startswith("the tangent turned"):
+                if reason.startswith("the tangent turned"):
+                    angle_reject = (ds, angle)
+                else:
                     angle_reject = None
                 ds *= 0.5
                 if ds < self.ds_min:
@@ -292,8 +259,8 @@ class Arclength:
             fold = lam_prev_sign != 0 and np.sign(t_new[-1]) != 0 and \
                 np.sign(t_new[-1]) != lam_prev_sign
             if fold:
-                h = float(np.linalg.norm(c.ev.xs - xs))
-                lam_f = fold_parameter(xs[-1], c.ev.xs[-1], t[-1], t_new[-1], h)
+                h = float(np.linalg.norm(c.xs - xs))
+                lam_f = fold_parameter(xs[-1], c.xs[-1], t[-1], t_new[-1], h)
                 self.folds.append(float(lam_f * s_lam))
             if np.sign(t_new[-1]) != 0:
                 lam_prev_sign = np.sign(t_new[-1])
@@ -301,20 +268,80 @@ class Arclength:
             if on_bound:
                 self.status = "finished"
                 self.message = (f"parameter left the bounds; last point solved on "
-                                f"lam={c.ev.xs[-1] * s_lam:.6g} after {steps} steps, "
+                                f"lam={c.xs[-1] * s_lam:.6g} after {steps} steps, "
                                 f"{len(self.folds)} folds, {self.n_rejected} rejections")
                 return
-            xs = c.ev.xs
+            xs = c.xs
             t = t_new
             factor = math.sqrt(o.target_iter / max(c.iterations, 1))
             factor = min(max(factor, o.shrink_min), o.grow_max)
             if angle > 0:
-                factor = min(factor, max(o.shrink_min, 0.8 * max_angle / angle))
+                factor = min(factor, max(o.shrink_min, 0.8 * math.radians(o.max_angle_deg) / angle))
             if consecutive:
                 factor = min(factor, 1.0)
             ds = min(max(ds * factor, self.ds_min), self.ds_max)
             consecutive = 0
             angle_reject = None
+
+    def _step(self, xs, t, ds, angle_reject, sphere):
+        """Predict and correct one step; return ``(c, t_new, angle, reason, on_bound)``.
+
+        ``reason`` is ``None`` when the step is acceptable.  ``sphere`` replaces the
+        hyperplane ``t @ (xs' - pred) = 0`` by the sphere ``|xs' - xs| = ds``, which may turn
+        by more than 90 degrees (a corner of the path); only a turn back onto the incoming
+        direction is refused then.
+        """
+        o = self.options
+        s_lam = self.scale[-1]
+        lo_s, hi_s = self.lam_bounds[0] / s_lam, self.lam_bounds[1] / s_lam
+        max_angle = math.radians(o.max_angle_deg)
+        pred = xs + ds * t
+        start = pred
+        on_bound = False
+        bound = hi_s if pred[-1] > hi_s else lo_s if pred[-1] < lo_s else None
+        if bound is not None:
+            start = xs + ((bound - xs[-1]) / (pred[-1] - xs[-1])) * (pred - xs)
+            c = self._fixed_lam(start, bound)
+            on_bound = True
+        else:
+            con = sphere_constraint(xs, ds) if sphere else linear_constraint(t, float(t @ pred))
+            c = self._correct(pred, con)
+            if c.converged and not lo_s <= c.xs[-1] <= hi_s:
+                bound = hi_s if c.xs[-1] > hi_s else lo_s
+                new = c.xs
+                start = xs + ((bound - xs[-1]) / (new[-1] - xs[-1])) * (new - xs)
+                c = self._fixed_lam(start, bound)
+                on_bound = True
+        if not c.converged:
+            return c, None, 0.0, f"Newton did not converge ({c.reason})", on_bound
+        chord = c.xs - xs
+        chord_len = float(np.linalg.norm(chord))
+        along = float(chord @ t)
+        if not chord_len > 0:
+            return c, None, 0.0, "the corrector returned to the last point", on_bound
+        if sphere:
+            if along <= -math.cos(max_angle) * chord_len:
+                return c, None, 0.0, "the corrector went back along the path", on_bound
+        elif along <= 0:
+            return c, None, 0.0, "the corrector went back along the path", on_bound
+        jump = float(np.linalg.norm(c.xs - start))
+        if not sphere and not on_bound and jump > o.max_correction * ds:
+            return (c, None, 0.0,
+                    f"the corrector moved {jump / ds:.2g} step lengths (branch jump)", on_bound)
+        t_new = null_tangent(c.ev.Js, t)
+        if t_new @ chord < 0:
+            t_new = -t_new
+        cosang = float(np.clip(t_new @ t, -1.0, 1.0))
+        angle = math.acos(cosang)
+        if cosang <= (-math.cos(max_angle) if sphere else 0.0):
+            return c, t_new, angle, "the tangent reversed", on_bound
+        if angle > max_angle:
+            kink = (angle_reject is not None and angle_reject[0] > ds
+                    and angle > 0.7 * angle_reject[1])
+            if not kink and 0.5 * ds >= self.ds_min:
+                return (c, t_new, angle, f"the tangent turned {math.degrees(angle):.1f} deg "
+                        f"> max_angle_deg={o.max_angle_deg:g}", on_bound)
+        return c, t_new, angle, None, on_bound
 
     def _fail(self, message: str) -> None:
         self.status = "failed"

@@ -4,11 +4,13 @@ With :math:`x = s \odot x_s` and :math:`J_s = J\,\mathrm{diag}(s)`, the correcto
 
 .. math::
 
-    R(s \odot x_s) = 0, \qquad g(x_s) = a^T x_s - b = 0,
+    R(s \odot x_s) = 0, \qquad g(x_s) = 0,
 
-which is the pseudo-arclength system for :math:`a = t`, :math:`b = t^T x_{s,pred}`, and the
-fixed-parameter system for :math:`a = e_\lambda`, :math:`b = \lambda / s_\lambda`.  Newton
-update, with the constraint row weighted by :math:`\rho` to balance the rows:
+with the linear constraint :math:`g = a^T x_s - b` (pseudo-arclength: :math:`a = t`,
+:math:`b = t^T x_{s,pred}`; fixed parameter: :math:`a = e_\lambda`,
+:math:`b = \lambda / s_\lambda`) or the sphere :math:`g = (\|x_s - c\|^2 - r^2) / (2r)`.
+Newton update with :math:`a = \nabla g`, the constraint row weighted by :math:`\rho` to
+balance the rows:
 
 .. math::
 
@@ -31,6 +33,11 @@ is solved with the current :math:`\|J_s\|_\infty` alone), so
 :math:`\|R\|_\infty \le tol\,\rho` and :math:`|g| \le tol\,(1 + \|x_s\|_\infty)`, or when the
 Newton update has fallen to round-off, :math:`\|\delta\|_\infty \le 16\,\epsilon\,(1 +
 \|x_s\|_\infty)`, with the residual already below :math:`\sqrt{tol}\,\rho`.
+
+Polishing: at convergence the Newton matrix at the last evaluation is already at hand, so one
+more update :math:`\delta` is solved and applied without calling the function again; by
+quadratic convergence the returned point is then accurate to about :math:`tol^2`, i.e. to
+round-off (the reported residual is the one before this update).
 """
 from __future__ import annotations
 
@@ -86,6 +93,9 @@ class Correction:
         ``||R||_inf / rho`` of ``ev``.
     reason : str
         Why it failed ('' when converged).
+    xs : ndarray, shape (n+1,) or None
+        The solution: ``ev.xs`` plus one last Newton update computed from ``ev`` without a
+        further call of the function (module doc); ``None`` means ``ev.xs``.
     """
 
     converged: bool
@@ -93,11 +103,33 @@ class Correction:
     iterations: int
     residual: float
     reason: str = ""
+    xs: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.xs is None:
+            self.xs = self.ev.xs
 
 
-def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray, a: np.ndarray,
-            b: float, rho0: float | None, tol: float, max_iter: int, max_backtrack: int) -> Correction:
-    """Newton with backtracking on ``[R(s*xs); a @ xs - b] = 0`` (module doc).
+Constraint = Callable[[np.ndarray], tuple[float, np.ndarray]]
+
+
+def linear_constraint(a: np.ndarray, b: float) -> Constraint:
+    """``g = a @ xs - b`` with gradient ``a``; ``a`` shape (n+1,)."""
+    a = np.asarray(a, dtype=float)
+    return lambda xs: (float(a @ xs - b), a)
+
+
+def sphere_constraint(center: np.ndarray, radius: float) -> Constraint:
+    """``g = (|xs - center|^2 - radius^2) / (2 radius)``, gradient ``(xs - center) / radius``."""
+    def g(xs):
+        d = xs - center
+        return float((d @ d - radius * radius) / (2.0 * radius)), d / radius
+    return g
+
+
+def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
+            constraint: Constraint, rho0: float | None, tol: float, max_iter: int, max_backtrack: int) -> Correction:
+    """Newton with backtracking on ``[R(s*xs); g(xs)] = 0`` (module doc).
 
     Parameters
     ----------
@@ -105,10 +137,9 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray, a: np
         ``xs (n+1,) -> Evaluation``; one call of the caller's function.
     xs0 : ndarray, shape (n+1,)
         Scaled starting guess (the predictor).
-    a : ndarray, shape (n+1,)
-        Constraint row (unit tangent or the parameter's unit vector).
-    b : float
-        Constraint right-hand side.
+    constraint : callable
+        ``xs -> (g, dg/dxs)``, e.g. :func:`linear_constraint` (arclength hyperplane, fixed
+        parameter) or :func:`sphere_constraint` (used to turn sharp corners of the path).
     rho0 : float or None
         Lower bound of the residual scale (> 0); ``None``: no bound, the scale is the current ``||Js||_inf``.
     tol : float
@@ -133,11 +164,10 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray, a: np
     for it in range(max_iter + 1):
         rho = max(rho0, ev.row_norm())
         res = float(np.abs(ev.R).max(initial=0.0)) / rho
-        g = float(a @ ev.xs - b)
+        g, a = constraint(ev.xs)
         size = 1.0 + float(np.abs(ev.xs).max())
-        if res <= tol and abs(g) <= tol * size:
-            return Correction(True, ev, it, res)
-        if it == max_iter:
+        converged = res <= tol and abs(g) <= tol * size
+        if it == max_iter and not converged:
             break
         A[:n] = ev.Js
         A[n] = rho * a
@@ -146,9 +176,14 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray, a: np
         try:
             delta = np.linalg.solve(A, rhs)
         except np.linalg.LinAlgError:
+            delta = None
+        if delta is None or not np.all(np.isfinite(delta)):
+            if converged:
+                return Correction(True, ev, it, res)
             return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
-        if not np.all(np.isfinite(delta)):
-            return Correction(False, ev, it, res, f"non-finite Newton update (residual {res:.1e})")
+        if converged:
+            # free polishing update: error ~ |delta|^2, no further call of the function
+            return Correction(True, ev, it, res, xs=ev.xs + delta)
         if np.abs(delta).max() <= 16 * _EPS * size and res <= np.sqrt(tol):
             return Correction(True, ev, it, res)
         merit = max(res, abs(g))
@@ -158,7 +193,7 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray, a: np
             if trial.finite:
                 rho_t = max(rho0, trial.row_norm())
                 merit_t = max(float(np.abs(trial.R).max(initial=0.0)) / rho_t,
-                              abs(float(a @ trial.xs - b)))
+                              abs(constraint(trial.xs)[0]))
                 if merit_t < merit or merit <= 1e3 * tol:
                     break
             theta *= 0.5
