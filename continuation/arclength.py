@@ -1,0 +1,348 @@
+r"""Pseudo-arclength continuation of :math:`R(y, \lambda) = 0` for any callable.
+
+The caller gives ``fun(x) -> (R, J)`` with :math:`x = [y, \lambda]` of shape (n+1,),
+:math:`R` of shape (n,) and :math:`J = dR/dx` of shape (n, n+1).  The solver works on scaled
+variables :math:`x_s = x / s` (:math:`J_s = J\,\mathrm{diag}(s)`); arclength is measured there.
+
+Step :math:`k \to k+1` with unit tangent :math:`t_k` and step :math:`ds`:
+
+.. math::
+
+    \text{predictor:}\quad x_{s,pred} = x_{s,k} + ds\, t_k, \qquad
+    \text{corrector:}\quad R(s \odot x_s) = 0,\;\; t_k^T (x_s - x_{s,pred}) = 0,
+
+then the new tangent :math:`t_{k+1}` spans the null space of :math:`J_s(x_{k+1})`
+(:mod:`continuation.tangent`) with the sign of the chord,
+:math:`t_{k+1}^T (x_{s,k+1} - x_{s,k}) > 0`.  A step is rejected (``ds`` halved) when Newton
+fails, the chord points backwards (:math:`t_k^T (x_{s,k+1} - x_{s,k}) \le 0`), the
+correction exceeds ``max_correction * ds``, or the tangents turn by more than
+``max_angle_deg``; a turn that does not shrink when ``ds`` is halved is a kink of the path
+(non-smooth Jacobian) and is accepted, so is any turn below 90 degrees once ``ds`` cannot be
+halved without going under ``ds_min``.  Accepted steps adapt ``ds`` as in
+:mod:`continuation.options`.
+
+Bounds: when the predictor (or the corrected point) leaves :math:`[\lambda_{lo},
+\lambda_{hi}]`, the last point is solved with :math:`\lambda` fixed on the bound, starting
+from the chord's crossing of the bound, and the run ends with status ``'finished'``.
+
+Folds: a sign change of :math:`t_\lambda` between two accepted points marks a turning point,
+located by cubic Hermite interpolation of :math:`\lambda(s)`.
+
+Default scale (``scale=None``): one common scale :math:`s_i = \|y_0\|_\infty` for all the
+unknowns (1 when :math:`y_0 = 0`), so that small unknowns (e.g. weak higher harmonics) are not
+inflated in the arclength, and :math:`s_\lambda = \max(|\lambda_0|,
+\lambda_{hi} - \lambda_{lo})` for the parameter (with infinite bounds
+:math:`\max(|\lambda_0|, 1)`).
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable, Iterator
+
+import numpy as np
+
+from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
+from .options import ArclengthOptions
+from .point import ContinuationPoint
+from .tangent import fold_parameter, null_tangent
+
+Fun = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def default_scale(x0: np.ndarray, lam_bounds: tuple[float, float]) -> np.ndarray:
+    """Per-unknown scales derived from the start (see module doc).
+
+    Parameters
+    ----------
+    x0 : ndarray, shape (n+1,)
+        Starting point ``[y0, lam0]``.
+    lam_bounds : (float, float)
+        Parameter bounds.
+
+    Returns
+    -------
+    ndarray, shape (n+1,)
+        Positive scales.
+    """
+    y0 = np.abs(x0[:-1])
+    ymax = float(y0.max(initial=0.0))
+    s = np.empty_like(x0)
+    s[:-1] = ymax if ymax > 0 else 1.0
+    lo, hi = lam_bounds
+    width = hi - lo if math.isfinite(hi - lo) else 1.0
+    s[-1] = max(abs(float(x0[-1])), width)
+    if s[-1] <= 0:
+        s[-1] = 1.0
+    return s
+
+
+class Arclength:
+    """Pseudo-arclength continuation; iterate it to get :class:`ContinuationPoint` objects.
+
+    Parameters
+    ----------
+    fun : callable
+        ``fun(x) -> (R, J)`` with ``x`` shape (n+1,), ``R`` shape (n,), ``J`` shape (n, n+1)
+        dense.  Called once per Newton iteration (plus once per predictor).
+    x0 : array_like, shape (n+1,)
+        Starting guess ``[y0, lam0]``; it is corrected with ``lam`` fixed at ``lam0``.
+    scale : array_like, shape (n+1,), or None
+        Positive scales, ``xs = x / scale``; ``None`` derives them from ``x0``
+        (:func:`default_scale`).
+    lam_bounds : (float, float)
+        Parameter interval; leaving it ends the run with a point exactly on the bound.
+    direction : {+1, -1}
+        Sign of the parameter's motion along the first tangent.
+    options : ArclengthOptions or None
+        ``None`` uses the defaults.
+
+    Attributes
+    ----------
+    status : str
+        ``'running'`` until iteration ends, then ``'finished'`` (left the bounds),
+        ``'max_steps'`` or ``'failed'``.
+    message : str
+        One-line explanation of ``status``.
+    n_rejected : int
+        Rejected steps.
+    folds : list of float
+        Parameter values of the folds passed.
+    n_eval : int
+        Calls of ``fun``.
+    points : list of ContinuationPoint
+        Points produced so far.
+    ds0, ds_min, ds_max : float
+        Resolved step lengths (scaled).
+    """
+
+    def __init__(self, fun: Fun, x0, scale=None, lam_bounds=(-np.inf, np.inf),
+                 direction: int = +1, options: ArclengthOptions | None = None):
+        x0 = np.array(x0, dtype=float).ravel()
+        if x0.size < 2 or not np.all(np.isfinite(x0)):
+            raise ValueError("x0 must be a finite vector [y, lam] with at least one unknown")
+        lo, hi = (float(v) for v in lam_bounds)
+        if not lo < hi:
+            raise ValueError(f"lam_bounds must satisfy lo < hi, got {lam_bounds}")
+        if not lo <= x0[-1] <= hi:
+            raise ValueError(f"starting parameter {x0[-1]:g} lies outside {lam_bounds}")
+        if direction not in (1, -1):
+            raise ValueError(f"direction must be +1 or -1, got {direction}")
+        if scale is None:
+            scale = default_scale(x0, (lo, hi))
+        scale = np.array(scale, dtype=float).ravel()
+        if scale.shape != x0.shape or not np.all(np.isfinite(scale)) or np.any(scale <= 0):
+            raise ValueError(f"scale must be {x0.size} positive finite numbers")
+        self.fun = fun
+        self.x0 = x0
+        self.scale = scale
+        self.lam_bounds = (lo, hi)
+        self.direction = direction
+        self.options = options if options is not None else ArclengthOptions()
+        self.ds0, self.ds_min, self.ds_max = self.options.step_lengths((hi - lo) / scale[-1])
+        self.status = "running"
+        self.message = ""
+        self.n_rejected = 0
+        self.folds: list[float] = []
+        self.n_eval = 0
+        self.points: list[ContinuationPoint] = []
+        self._started = False
+        self._rho0: float | None = None
+
+    # ------------------------------------------------------------------ evaluation
+    def _evaluate(self, xs: np.ndarray) -> Evaluation:
+        self.n_eval += 1
+        n = xs.size - 1
+        with np.errstate(all="ignore"):
+            R, J = self.fun(xs * self.scale)
+            R = np.asarray(R, dtype=float).reshape(-1)
+            J = np.asarray(J, dtype=float)
+            if R.shape != (n,) or J.shape != (n, n + 1):
+                raise ValueError(f"fun must return R shape ({n},) and J shape ({n}, {n + 1}), "
+                                 f"got {R.shape} and {J.shape}")
+            return Evaluation(xs.copy(), R, J * self.scale[None, :])
+
+    def _correct(self, xs0, constraint) -> Correction:
+        o = self.options
+        return correct(self._evaluate, xs0, constraint, self._rho0, o.tol, o.max_iter,
+                       o.max_backtrack)
+
+    def _fixed_lam(self, xs0: np.ndarray, lam_s: float) -> Correction:
+        e = np.zeros_like(xs0)
+        e[-1] = 1.0
+        start = xs0.copy()
+        start[-1] = lam_s
+        c = self._correct(start, linear_constraint(e, lam_s))
+        c.xs[-1] = lam_s  # exactly on the requested value despite round-off in the update
+        return c
+
+    # ------------------------------------------------------------------ iteration
+    def __iter__(self) -> Iterator[ContinuationPoint]:
+        if self._started:
+            yield from list(self.points)
+            return
+        self._started = True
+        yield from self._run()
+
+    def run(self) -> list[ContinuationPoint]:
+        """Trace the whole path and return its points (same as ``list(self)``)."""
+        return list(self)
+
+    def _point(self, c: Correction, t, ds, fold, on_bound=False) -> ContinuationPoint:
+        pt = ContinuationPoint(x=c.xs * self.scale, tangent=t.copy(), iterations=c.iterations,
+                               ds=float(ds), fold=bool(fold), residual_norm=float(c.residual),
+                               on_bound=on_bound)
+        self.points.append(pt)
+        return pt
+
+    def _run(self) -> Iterator[ContinuationPoint]:
+        o = self.options
+        s_lam = self.scale[-1]
+        lo_s, hi_s = self.lam_bounds[0] / s_lam, self.lam_bounds[1] / s_lam
+        xs = self.x0 / self.scale
+
+        # --- starting point, parameter fixed; its Jacobian row norm becomes rho0
+        self._rho0 = None
+        c = self._fixed_lam(xs, xs[-1])
+        self._rho0 = c.ev.row_norm() or 1.0
+        if not c.converged:
+            self._fail(f"starting point not solved at lam={self.x0[-1]:.6g}: {c.reason}")
+            return
+        e = np.zeros_like(xs)
+        e[-1] = self.direction
+        t = null_tangent(c.ev.Js, e)
+        if t[-1] * self.direction < 0:
+            t = -t
+        yield self._point(c, t, 0.0, False, on_bound=xs[-1] in (lo_s, hi_s))
+        xs = c.xs
+        lam_prev_sign = np.sign(t[-1])
+
+        ds = self.ds0
+        steps = 0
+        consecutive = 0
+        angle_reject = None   # (ds, angle) of the last rejection for the angle
+        while True:
+            if steps >= o.max_steps:
+                self.status = "max_steps"
+                self.message = (f"stopped after max_steps={o.max_steps} steps at "
+                                f"lam={xs[-1] * s_lam:.6g}")
+                return
+            if (xs[-1] >= hi_s and t[-1] > 0) or (xs[-1] <= lo_s and t[-1] < 0):
+                self.status = "finished"
+                self.message = f"parameter reached the bound lam={xs[-1] * s_lam:.6g}"
+                return
+
+            c, t_new, angle, reason, on_bound = self._step(xs, t, ds, angle_reject, False)
+            if reason is not None and consecutive >= 1 and not on_bound:
+                # repeated trouble at this point: maybe a sharp corner of the path, which a
+                # hyperplane normal to t cannot cross; try a sphere around the last point
+                c2, t2, a2, r2, b2 = self._step(xs, t, ds, angle_reject, True)
+                if r2 is None or r2.startswith("the tangent turned"):
+                    c, t_new, angle, reason, on_bound = c2, t2, a2, r2, b2
+
+            if reason is not None:
+                self.n_rejected += 1
+                consecutive += 1
+                if reason.startswith("the tangent turned"):
+                    angle_reject = (ds, angle)
+                else:
+                    angle_reject = None
+                ds *= 0.5
+                if ds < self.ds_min:
+                    self._fail(f"step size fell below ds_min={self.ds_min:.3g} at "
+                               f"lam={xs[-1] * s_lam:.6g} after {consecutive} rejections: "
+                               f"{reason}")
+                    return
+                continue
+
+            # --- accept
+            steps += 1
+            fold = lam_prev_sign != 0 and np.sign(t_new[-1]) != 0 and \
+                np.sign(t_new[-1]) != lam_prev_sign
+            if fold:
+                h = float(np.linalg.norm(c.xs - xs))
+                lam_f = fold_parameter(xs[-1], c.xs[-1], t[-1], t_new[-1], h)
+                self.folds.append(float(lam_f * s_lam))
+            if np.sign(t_new[-1]) != 0:
+                lam_prev_sign = np.sign(t_new[-1])
+            yield self._point(c, t_new, ds, fold, on_bound=on_bound)
+            if on_bound:
+                self.status = "finished"
+                self.message = (f"parameter left the bounds; last point solved on "
+                                f"lam={c.xs[-1] * s_lam:.6g} after {steps} steps, "
+                                f"{len(self.folds)} folds, {self.n_rejected} rejections")
+                return
+            xs = c.xs
+            t = t_new
+            factor = math.sqrt(o.target_iter / max(c.iterations, 1))
+            factor = min(max(factor, o.shrink_min), o.grow_max)
+            if angle > 0:
+                factor = min(factor, max(o.shrink_min, 0.8 * math.radians(o.max_angle_deg) / angle))
+            if consecutive:
+                factor = min(factor, 1.0)
+            ds = min(max(ds * factor, self.ds_min), self.ds_max)
+            consecutive = 0
+            angle_reject = None
+
+    def _step(self, xs, t, ds, angle_reject, sphere):
+        """Predict and correct one step; return ``(c, t_new, angle, reason, on_bound)``.
+
+        ``reason`` is ``None`` when the step is acceptable.  ``sphere`` replaces the
+        hyperplane ``t @ (xs' - pred) = 0`` by the sphere ``|xs' - xs| = ds``, which may turn
+        by more than 90 degrees (a corner of the path); only a turn back onto the incoming
+        direction is refused then.
+        """
+        o = self.options
+        s_lam = self.scale[-1]
+        lo_s, hi_s = self.lam_bounds[0] / s_lam, self.lam_bounds[1] / s_lam
+        max_angle = math.radians(o.max_angle_deg)
+        pred = xs + ds * t
+        start = pred
+        on_bound = False
+        bound = hi_s if pred[-1] > hi_s else lo_s if pred[-1] < lo_s else None
+        if bound is not None:
+            start = xs + ((bound - xs[-1]) / (pred[-1] - xs[-1])) * (pred - xs)
+            c = self._fixed_lam(start, bound)
+            on_bound = True
+        else:
+            con = sphere_constraint(xs, ds) if sphere else linear_constraint(t, float(t @ pred))
+            c = self._correct(pred, con)
+            if c.converged and not lo_s <= c.xs[-1] <= hi_s:
+                bound = hi_s if c.xs[-1] > hi_s else lo_s
+                new = c.xs
+                start = xs + ((bound - xs[-1]) / (new[-1] - xs[-1])) * (new - xs)
+                c = self._fixed_lam(start, bound)
+                on_bound = True
+        if not c.converged:
+            return c, None, 0.0, f"Newton did not converge ({c.reason})", on_bound
+        chord = c.xs - xs
+        chord_len = float(np.linalg.norm(chord))
+        along = float(chord @ t)
+        if not chord_len > 0:
+            return c, None, 0.0, "the corrector returned to the last point", on_bound
+        if sphere:
+            if along <= -math.cos(max_angle) * chord_len:
+                return c, None, 0.0, "the corrector went back along the path", on_bound
+        elif along <= 0:
+            return c, None, 0.0, "the corrector went back along the path", on_bound
+        jump = float(np.linalg.norm(c.xs - start))
+        if not sphere and not on_bound and jump > o.max_correction * ds:
+            return (c, None, 0.0,
+                    f"the corrector moved {jump / ds:.2g} step lengths (branch jump)", on_bound)
+        t_new = null_tangent(c.ev.Js, t)
+        if t_new @ chord < 0:
+            t_new = -t_new
+        cosang = float(np.clip(t_new @ t, -1.0, 1.0))
+        angle = math.acos(cosang)
+        if cosang <= (-math.cos(max_angle) if sphere else 0.0):
+            return c, t_new, angle, "the tangent reversed", on_bound
+        if angle > max_angle:
+            kink = (angle_reject is not None and angle_reject[0] > ds
+                    and angle > 0.7 * angle_reject[1])
+            if not kink and 0.5 * ds >= self.ds_min:
+                return (c, t_new, angle, f"the tangent turned {math.degrees(angle):.1f} deg "
+                        f"> max_angle_deg={o.max_angle_deg:g}", on_bound)
+        return c, t_new, angle, None, on_bound
+
+    def _fail(self, message: str) -> None:
+        self.status = "failed"
+        self.message = message

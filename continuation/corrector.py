@@ -1,0 +1,209 @@
+r"""Newton corrector for ``R(x) = 0`` closed by one linear constraint, in scaled variables.
+
+With :math:`x = s \odot x_s` and :math:`J_s = J\,\mathrm{diag}(s)`, the corrector solves
+
+.. math::
+
+    R(s \odot x_s) = 0, \qquad g(x_s) = 0,
+
+with the linear constraint :math:`g = a^T x_s - b` (pseudo-arclength: :math:`a = t`,
+:math:`b = t^T x_{s,pred}`; fixed parameter: :math:`a = e_\lambda`,
+:math:`b = \lambda / s_\lambda`) or the sphere :math:`g = (\|x_s - c\|^2 - r^2) / (2r)`.
+Newton update with :math:`a = \nabla g`, the constraint row weighted by :math:`\rho` to
+balance the rows:
+
+.. math::
+
+    \begin{bmatrix} J_s \\ \rho\, a^T \end{bmatrix} \delta
+        = -\begin{bmatrix} R \\ \rho\, g \end{bmatrix}, \qquad x_s \leftarrow x_s + \theta\delta,
+
+with :math:`\theta = 1, 1/2, 1/4, \dots` while the merit
+:math:`\max(\|R\|_\infty/\rho, |g|)` does not decrease (backtracking).
+
+Convergence test (scaled residual): the residual scale is
+
+.. math::
+
+    \rho = \max\big(\rho_0, \|J_s(x)\|_\infty\big),
+
+the largest change of a residual entry produced by unit changes of the scaled unknowns
+(:math:`\rho_0` is the value at the converged starting point; the starting point itself
+is solved with the current :math:`\|J_s\|_\infty` alone), so
+:math:`\|R\|_\infty / \rho` estimates the error in the scaled unknowns.  Converged when
+:math:`\|R\|_\infty \le tol\,\rho` and :math:`|g| \le tol\,(1 + \|x_s\|_\infty)`, or when the
+Newton update has fallen to round-off, :math:`\|\delta\|_\infty \le 16\,\epsilon\,(1 +
+\|x_s\|_\infty)`, with the residual already below :math:`\sqrt{tol}\,\rho`.
+
+Polishing: at convergence the Newton matrix at the last evaluation is already at hand, so one
+more update :math:`\delta` is solved and applied without calling the function again; by
+quadratic convergence the returned point is then accurate to about :math:`tol^2`, i.e. to
+round-off (the reported residual is the one before this update).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+_EPS = np.finfo(float).eps
+
+
+@dataclass
+class Evaluation:
+    """The caller's function at one scaled point.
+
+    Parameters
+    ----------
+    xs : ndarray, shape (n+1,)
+        Scaled point.
+    R : ndarray, shape (n,)
+        Residual.
+    Js : ndarray, shape (n, n+1)
+        Scaled Jacobian ``J * scale``.
+    """
+
+    xs: np.ndarray
+    R: np.ndarray
+    Js: np.ndarray
+
+    @property
+    def finite(self) -> bool:
+        """Residual and Jacobian are free of NaN and inf."""
+        return bool(np.all(np.isfinite(self.R)) and np.all(np.isfinite(self.Js)))
+
+    def row_norm(self) -> float:
+        """``||Js||_inf`` (largest absolute row sum); 0 when not finite."""
+        return float(np.abs(self.Js).sum(axis=1).max(initial=0.0)) if self.finite else 0.0
+
+
+@dataclass
+class Correction:
+    """Result of :func:`correct`.
+
+    Parameters
+    ----------
+    converged : bool
+        The convergence test passed.
+    ev : Evaluation
+        Last accepted evaluation (the solution when converged; its Jacobian gives the tangent).
+    iterations : int
+        Newton updates applied.
+    residual : float
+        ``||R||_inf / rho`` of ``ev``.
+    reason : str
+        Why it failed ('' when converged).
+    xs : ndarray, shape (n+1,) or None
+        The solution: ``ev.xs`` plus one last Newton update computed from ``ev`` without a
+        further call of the function (module doc); ``None`` means ``ev.xs``.
+    """
+
+    converged: bool
+    ev: Evaluation
+    iterations: int
+    residual: float
+    reason: str = ""
+    xs: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.xs is None:
+            self.xs = self.ev.xs
+
+
+Constraint = Callable[[np.ndarray], tuple[float, np.ndarray]]
+
+
+def linear_constraint(a: np.ndarray, b: float) -> Constraint:
+    """``g = a @ xs - b`` with gradient ``a``; ``a`` shape (n+1,)."""
+    a = np.asarray(a, dtype=float)
+    return lambda xs: (float(a @ xs - b), a)
+
+
+def sphere_constraint(center: np.ndarray, radius: float) -> Constraint:
+    """``g = (|xs - center|^2 - radius^2) / (2 radius)``, gradient ``(xs - center) / radius``."""
+    def g(xs):
+        d = xs - center
+        return float((d @ d - radius * radius) / (2.0 * radius)), d / radius
+    return g
+
+
+def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
+            constraint: Constraint, rho0: float | None, tol: float, max_iter: int, max_backtrack: int) -> Correction:
+    """Newton with backtracking on ``[R(s*xs); g(xs)] = 0`` (module doc).
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``xs (n+1,) -> Evaluation``; one call of the caller's function.
+    xs0 : ndarray, shape (n+1,)
+        Scaled starting guess (the predictor).
+    constraint : callable
+        ``xs -> (g, dg/dxs)``, e.g. :func:`linear_constraint` (arclength hyperplane, fixed
+        parameter) or :func:`sphere_constraint` (used to turn sharp corners of the path).
+    rho0 : float or None
+        Lower bound of the residual scale (> 0); ``None``: no bound, the scale is the current ``||Js||_inf``.
+    tol : float
+        Tolerance on the scaled residual.
+    max_iter : int
+        Newton updates allowed.
+    max_backtrack : int
+        Halvings of an update tried when the merit grows.
+
+    Returns
+    -------
+    Correction
+    """
+    ev = evaluate(xs0)
+    if not ev.finite:
+        return Correction(False, ev, 0, np.inf, "residual is not finite at the predictor")
+    if rho0 is None:
+        rho0 = 1e-300
+    n = ev.R.size
+    rhs = np.empty(n + 1)
+    A = np.empty((n + 1, n + 1))
+    for it in range(max_iter + 1):
+        rho = max(rho0, ev.row_norm())
+        res = float(np.abs(ev.R).max(initial=0.0)) / rho
+        g, a = constraint(ev.xs)
+        size = 1.0 + float(np.abs(ev.xs).max())
+        converged = res <= tol and abs(g) <= tol * size
+        if it == max_iter and not converged:
+            break
+        A[:n] = ev.Js
+        A[n] = rho * a
+        rhs[:n] = -ev.R
+        rhs[n] = -rho * g
+        try:
+            delta = np.linalg.solve(A, rhs)
+        except np.linalg.LinAlgError:
+            delta = None
+        if delta is None or not np.all(np.isfinite(delta)):
+            if converged:
+                return Correction(True, ev, it, res)
+            return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
+        if converged:
+            # free polishing update: error ~ |delta|^2, no further call of the function
+            return Correction(True, ev, it, res, xs=ev.xs + delta)
+        if np.abs(delta).max() <= 16 * _EPS * size and res <= np.sqrt(tol):
+            return Correction(True, ev, it, res)
+        merit = max(res, abs(g))
+        theta = 1.0
+        for _ in range(max_backtrack + 1):
+            trial = evaluate(ev.xs + theta * delta)
+            if trial.finite:
+                rho_t = max(rho0, trial.row_norm())
+                merit_t = max(float(np.abs(trial.R).max(initial=0.0)) / rho_t,
+                              abs(constraint(trial.xs)[0]))
+                if merit_t < merit or merit <= 1e3 * tol:
+                    break
+            theta *= 0.5
+        else:
+            if not trial.finite:
+                return Correction(False, ev, it + 1, res,
+                                  f"residual not finite along the Newton update (residual {res:.1e})")
+            # no decrease even for a short step: take it anyway, the iteration limit decides
+        ev = trial
+    rho = max(rho0, ev.row_norm())
+    res = float(np.abs(ev.R).max(initial=0.0)) / rho
+    return Correction(False, ev, max_iter, res,
+                      f"no convergence in {max_iter} iterations (residual {res:.1e})")

@@ -1,0 +1,90 @@
+r"""Path tangent from the null vector of the scaled Jacobian, and fold location.
+
+Tangent: with the scaled Jacobian :math:`J_s = J\,\mathrm{diag}(s)` of shape (n, n+1) and a
+reference direction :math:`t_r` (the previous tangent), solve the bordered system
+
+.. math::
+
+    \begin{bmatrix} J_s \\ \rho\, t_r^T \end{bmatrix} v = \begin{bmatrix} 0 \\ \rho \end{bmatrix},
+    \qquad t = v / \|v\|,
+
+where :math:`\rho = \|J_s\|_\infty` only balances the rows.  If the system is singular the
+last right singular vector of :math:`J_s` is used instead.
+
+Fold location: between two points a distance :math:`h = \|x_{s,1} - x_{s,0}\|` apart, the
+parameter is interpolated by the cubic Hermite polynomial matching
+:math:`\lambda_0, \lambda_1` and the slopes :math:`d\lambda/ds = t_{\lambda,0}, t_{\lambda,1}`,
+
+.. math::
+
+    p(\tau) = \lambda_0 + h t_0 \tau + (3\Delta - 2 h t_0 - h t_1)\tau^2
+              + (h t_0 + h t_1 - 2\Delta)\tau^3, \qquad \Delta = \lambda_1 - \lambda_0,
+
+and the fold is :math:`p(\tau^*)` with :math:`p'(\tau^*) = 0`, :math:`\tau^* \in [0, 1]`
+(exact when :math:`\lambda(s)` is quadratic near the fold).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def null_tangent(Js: np.ndarray, t_ref: np.ndarray) -> np.ndarray:
+    """Unit null vector of ``Js`` with a positive component along ``t_ref``.
+
+    Parameters
+    ----------
+    Js : ndarray, shape (n, n+1)
+        Scaled Jacobian ``dR/dxs``.
+    t_ref : ndarray, shape (n+1,)
+        Reference direction (unit), e.g. the previous tangent.
+
+    Returns
+    -------
+    t : ndarray, shape (n+1,)
+        Unit tangent with ``t @ t_ref >= 0``; NaN-free whenever ``Js`` is finite.
+    """
+    n = Js.shape[0]
+    rho = max(float(np.abs(Js).sum(axis=1).max(initial=0.0)), 1e-300)
+    A = np.vstack([Js, rho * t_ref[None, :]])
+    rhs = np.zeros(n + 1)
+    rhs[-1] = rho
+    try:
+        v = np.linalg.solve(A, rhs)
+    except np.linalg.LinAlgError:
+        v = None
+    if v is None or not np.all(np.isfinite(v)) or not np.any(v):
+        v = np.linalg.svd(Js)[2][-1]
+    t = v / np.linalg.norm(v)
+    return -t if t @ t_ref < 0 else t
+
+
+def fold_parameter(lam0: float, lam1: float, m0: float, m1: float, h: float) -> float:
+    """Parameter value of a fold between two points (cubic Hermite, see module doc).
+
+    Parameters
+    ----------
+    lam0, lam1 : float
+        Scaled parameter at the two points.
+    m0, m1 : float
+        Parameter components of the unit tangents (opposite signs).
+    h : float
+        Scaled distance between the points.
+
+    Returns
+    -------
+    float
+        Scaled parameter at the fold; falls back to linear interpolation of the tangent
+        component when the cubic has no stationary point in ``[0, 1]``.
+    """
+    d = lam1 - lam0
+    b = 3.0 * d - 2.0 * h * m0 - h * m1
+    c = h * m0 + h * m1 - 2.0 * d
+    # p'(tau) = h m0 + 2 b tau + 3 c tau^2
+    roots = np.roots([3.0 * c, 2.0 * b, h * m0]) if (c or b) else np.array([])
+    tau_lin = m0 / (m0 - m1) if m0 != m1 else 0.5
+    good = [r.real for r in np.atleast_1d(roots)
+            if abs(r.imag) < 1e-12 and -1e-9 <= r.real <= 1.0 + 1e-9]
+    if good:
+        tau = min(good, key=lambda r: abs(r - tau_lin))
+        return lam0 + h * m0 * tau + b * tau**2 + c * tau**3
+    return lam0 + tau_lin * d
