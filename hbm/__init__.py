@@ -9,8 +9,8 @@ from .case import Case, CaseError, load_case
 
 
 def frf(case, harmonics=None, samples=None, fmin=None, fmax=None, **kwargs):
-    """Trace the FRF of a case; see :func:`hbm.frf.frf`."""
-    from .frf import frf as _frf
+    """Trace the FRF of a case; see :func:`hbm.response.frf`."""
+    from .response import frf as _frf
     return _frf(case, harmonics=harmonics, samples=samples, fmin=fmin, fmax=fmax, **kwargs)
 
 

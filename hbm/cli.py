@@ -72,7 +72,7 @@ def _progress(n, f):
 
 
 def cmd_frf(args) -> int:
-    from .frf import frf
+    from .response import frf
     from .report import write_frf
     case = load_case(args.case)
     res = frf(case, harmonics=args.harmonics, samples=args.samples, fmin=args.fmin, fmax=args.fmax,

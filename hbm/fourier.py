@@ -194,3 +194,37 @@ def first_harmonic_amplitude(basis: FourierBasis, X: np.ndarray) -> np.ndarray:
         return np.zeros(X.shape[1:])
     rc = basis.row_of(1, "c")
     return np.hypot(X[rc], X[rc + 1])
+
+
+def max_abs(basis: FourierBasis, X: np.ndarray, n_fine: int | None = None) -> np.ndarray:
+    """Maximum over one period of ``|x(t)|`` for each column of ``X`` (n_coef, m) -> (m,).
+
+    The maximum is bracketed on a fine grid and then refined by Newton iterations on
+    ``dx/dtheta = 0`` of the trigonometric polynomial, so it is exact to round-off rather
+    than to the grid spacing.
+    """
+    X = np.atleast_2d(X)
+    if X.shape[1] == 0:
+        return np.zeros(0)
+    n_fine = n_fine or max(256, 16 * int(basis.harmonics.max()))
+    theta_grid = 2.0 * np.pi * np.arange(n_fine) / n_fine
+    x = basis_matrix(basis.h_of_row, theta_grid) @ X
+    j = np.argmax(np.abs(x), axis=0)
+    th = theta_grid[j]
+    h = basis.h_of_row.astype(float)
+    is_c = np.zeros(h.size, dtype=bool)
+    is_c[[r for r in range(h.size) if h[r] > 0 and (r == 0 or h[r - 1] != h[r])]] = True
+    is_s = np.roll(is_c, 1) & (h > 0)
+    cols = np.arange(X.shape[1])
+    for _ in range(4):
+        ht = np.outer(th, h)                      # (m, n_coef)
+        c, s = np.cos(ht), np.sin(ht)
+        d1 = np.where(is_c, -h * s, np.where(is_s, h * c, 0.0))
+        d2 = np.where(is_c, -h * h * c, np.where(is_s, -h * h * s, 0.0))
+        g1 = np.einsum("mk,km->m", d1, X)
+        g2 = np.einsum("mk,km->m", d2, X)
+        step = np.where(np.abs(g2) > 1e-300, g1 / np.where(g2 == 0, 1.0, g2), 0.0)
+        step = np.clip(step, -np.pi / n_fine, np.pi / n_fine)
+        th = th - step
+    vals = np.abs(np.einsum("mk,km->m", basis_matrix(basis.h_of_row, th), X))
+    return np.maximum(vals, np.abs(x[j, cols]))

@@ -19,7 +19,7 @@ from continuation import Arclength, ArclengthOptions
 
 from .case import Case, CaseError
 from .energy import energy_balance
-from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples
+from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
 from .newton import newton
 from .residual import HarmonicBalance
 from .transforms import make_transform
@@ -187,7 +187,6 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
                 "transform": problem.nl.transform.name}
     shape = problem.Fex.shape
-    fine = basis.fine_grid()
     out_dofs = case.analysis.outputs
     pts_X, pts_w, its, eerr = [], [], [], []
     status, message, folds, n_rej = "failed", "", [], 0
@@ -227,7 +226,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             h1 = np.hypot(xd[:, rc], xd[:, rc + 1])
         else:
             h1 = np.zeros(Xs.shape[0])
-        mx = np.abs(xd @ fine.T).max(axis=1) if Xs.shape[0] else np.zeros(0)
+        mx = max_abs(basis, xd.T)
         outputs[name] = OutputSeries(h1, mx)
     return FRFResult(np.array(pts_w) / (2 * np.pi), outputs, Xs, basis, None, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings)
@@ -260,4 +259,4 @@ def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform
 def output_amplitudes(basis: FourierBasis, x: np.ndarray):
     """``(h1, max)`` of one DOF's coefficients ``x`` (n_coef,)."""
     rc = basis.row_of(1, "c")
-    return float(np.hypot(x[rc], x[rc + 1])), float(np.abs(basis.fine_grid() @ x).max())
+    return float(np.hypot(x[rc], x[rc + 1])), float(max_abs(basis, x[:, None])[0])
