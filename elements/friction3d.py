@@ -29,8 +29,11 @@ class Friction3D(Element):
     load the slider position is only forgotten geometrically, pass after pass: the component
     of the slider offset across a nearly fixed slip direction, and partial slip that shakes
     down towards an elastic loop, contract slowly (up to ~130 passes seen on random ellipses
-    to reach 1e-12), hence ``max_passes = 200`` and ``closure_tol = 1e-12``.  A pass costs
-    N steps, so this stays cheap.
+    to reach 1e-12; near the stick/slip boundary more than 1000).  So this element closes the
+    loop by Newton on the start state (:func:`elements.closure.march_newton`: the period map
+    and its state derivative come from the same pass), with plain passes as the fallback,
+    ``max_passes = 1000`` (reached only by loops that shake down asymptotically) and
+    ``closure_tol = 1e-12``.
     """
 
     kind = FRICTION3D
@@ -38,7 +41,7 @@ class Friction3D(Element):
     needs_mean = True       # normal-load variation gives mean forces
     keys = ("type", "dofs", "kt", "kn", "mu", "normal_preload", "name")
     dof_keys = ("t1", "t2", "n")
-    max_passes = 200
+    max_passes = 1000
     closure_tol = 1e-12
 
     def __init__(self, gather, kt, kn, mu, normal_preload, name="friction3d"):
@@ -93,6 +96,16 @@ class Friction3D(Element):
             return int(np.argmax(c[:, 0]))
         _, vecs = np.linalg.eigh(c.T @ c)
         return int(np.argmax(c @ vecs[:, -1]))
+
+    def march(self, z, dz):
+        """Forces and seeded derivatives over one period, loop closed by Newton (see class doc)."""
+        from .closure import march_newton
+        f, df, passes = march_newton(self.kind, self.params, self.n_state, self.n_local,
+                                     np.ascontiguousarray(z, dtype=float),
+                                     np.ascontiguousarray(dz, dtype=float),
+                                     self.start_index(np.asarray(z)[:, :self.n_local]),
+                                     self.max_passes, self.closure_tol)
+        return f, df
 
     def linear_stiffness(self):
         """Tangent at rest: ``kn`` along n (closing side), ``kt`` along t1, t2 if ``mu N0 > 0``."""

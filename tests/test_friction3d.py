@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from elements import ELEMENTS, Friction3D, Jenkins
-from elements.kernels import march, law_step
+from elements.kernels import law_step
+from elements.closure import march_newton
 from hbm.fourier import FourierBasis
 
 KT, KN, MU, N0 = 1.0, 2.0, 0.5, 1.0       # mu N0 / kt = 0.5
@@ -15,11 +16,11 @@ def make(nt=2, kt=KT, kn=KN, mu=MU, n0=N0):
 
 
 def run(el, z, dz=None):
-    """March through the kernel directly so that the closure is asserted."""
+    """March through the element's closure kernel directly so that the closure is asserted."""
     z = np.ascontiguousarray(z, dtype=float)
     if dz is None:
         dz = np.zeros(z.shape + (1,))
-    f, df, passes = march(el.kind, el.params, el.n_state, el.n_local, z, np.ascontiguousarray(dz),
+    f, df, passes = march_newton(el.kind, el.params, el.n_state, el.n_local, z, np.ascontiguousarray(dz),
                           el.start_index(z[:, :el.n_local]), el.max_passes, el.closure_tol)
     assert passes > 0, "loop did not close"
     return f, df
@@ -76,7 +77,7 @@ def ellipse_coeffs(a1, a2, phase, an, phase_n, rng, nt=2):
     return X
 
 
-PATHS = ["stick2d", "slip1d", "mixed1d", "mixed2d", "separation1d", "separation2d"]
+PATHS = ["stick2d", "slip1d", "mixed1d", "mixed2d", "separation1d", "separation2d", "line3d"]
 
 
 @pytest.mark.parametrize("case", PATHS)
@@ -92,13 +93,18 @@ def test_fd_jacobian_paths(case):
         el, X = make(2), ellipse_coeffs(0.9, 0.5, 1.1, 0.2, 2.0, rng)
     elif case == "separation1d":
         el, X = make(1), ellipse_coeffs(0.8, 0, 0, 0.9, 0.3, rng, nt=1)
-    else:
+    elif case == "separation2d":
         el, X = make(2), ellipse_coeffs(0.8, 0.6, 0.7, 0.9, 2.5, rng)
+    else:
+        # 3D contact slipping along a line (no t2 motion): the state is periodic after one
+        # pass but the transverse derivative is not; closure must converge the seeds too
+        el, X = make(2), ellipse_coeffs(1.5, 0.0, 0.0, 0.1, 0.5, rng)
+        X[:, 1] = 0.0
     err, summ = fd_error(el, BASIS, X)
     # the path really is of the advertised kind
     if case.startswith("stick"):
         assert summ["slip_fraction"] == 0.0 and summ["open_fraction"] == 0.0
-    elif case.startswith("slip"):
+    elif case.startswith("slip") or case == "line3d":
         assert summ["slip_fraction"] > 0.5 and summ["open_fraction"] == 0.0
     elif case.startswith("mixed"):
         assert 0.0 < summ["slip_fraction"] < 1.0 and summ["open_fraction"] == 0.0
