@@ -6,10 +6,16 @@ from ``hbm``.
 from .base import Element
 from .jenkins import Jenkins
 from .cubic import Cubic
+from .friction3d import Friction3D
+from .coulomb import CoulombStickSlip, CoulombRegularised
 
 ELEMENTS = {
     "jenkins": Jenkins,
     "cubic": Cubic,
+    "friction3d": Friction3D,
+    "coulomb_stick_slip": CoulombStickSlip,
+    "coulomb_regularised": CoulombRegularised,
 }
 
-__all__ = ["ELEMENTS", "Element", "Jenkins", "Cubic"]
+__all__ = ["ELEMENTS", "Element", "Jenkins", "Cubic", "Friction3D", "CoulombStickSlip",
+           "CoulombRegularised"]

@@ -23,9 +23,11 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .kinds import JENKINS, CUBIC
+from .kinds import JENKINS, CUBIC, FRICTION3D, COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
 from .laws.jenkins import jenkins_step, jenkins_init
 from .laws.cubic import cubic_step, cubic_init
+from .laws.friction3d import friction3d_step, friction3d_init
+from .laws.coulomb import coulomb_sk_step, coulomb_sk_init, coulomb_reg_step, coulomb_reg_init
 
 
 @nb.njit(cache=True)
@@ -35,6 +37,12 @@ def law_step(kind, p, s, z, s_new, A, B):
         jenkins_step(p, s, z, s_new, A, B)
     elif kind == CUBIC:
         cubic_step(p, s, z, s_new, A, B)
+    elif kind == FRICTION3D:
+        friction3d_step(p, s, z, s_new, A, B)
+    elif kind == COULOMB_STATIC_KINETIC:
+        coulomb_sk_step(p, s, z, s_new, A, B)
+    elif kind == COULOMB_REGULARISED:
+        coulomb_reg_step(p, s, z, s_new, A, B)
     else:
         raise ValueError("unknown law kind")
 
@@ -46,6 +54,12 @@ def law_init(kind, p, z0, s0, C0):
         jenkins_init(p, z0, s0, C0)
     elif kind == CUBIC:
         cubic_init(p, z0, s0, C0)
+    elif kind == FRICTION3D:
+        friction3d_init(p, z0, s0, C0)
+    elif kind == COULOMB_STATIC_KINETIC:
+        coulomb_sk_init(p, z0, s0, C0)
+    elif kind == COULOMB_REGULARISED:
+        coulomb_reg_init(p, z0, s0, C0)
     else:
         raise ValueError("unknown law kind")
 

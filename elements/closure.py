@@ -1,0 +1,123 @@
+r"""Periodic closure of a path-dependent law by Newton on the state at the start sample.
+
+:func:`elements.kernels.march` closes a hysteresis loop by marching whole periods until the
+state repeats.  That converges geometrically at the rate of the period map's contraction,
+which for 2D friction loops near the stick/slip boundary (little slip per cycle, or slip in
+a nearly fixed direction) is close to one: thousands of passes.  Here the period map
+``s_end = Phi_T(s_begin)`` is differentiated along with the march, ``M = ds_end/ds_begin``
+(``M_T = A_N ... A_1``, ns x ns), and the start state is updated by Newton,
+
+.. math::
+
+    s_{begin} \leftarrow s_{begin} + (I - M)^{-1} (s_{end} - s_{begin}),
+
+which is exact in one step while the stick/slip pattern of the samples does not change.
+The parameter seeds obey the same affine map, ``ds_end = M ds_begin + g``, so the same
+update gives the seeds of the periodic solution, ``ds* = (I - M)^{-1} g``.
+
+Rules (so that the physical transient from the rest state is kept where it decides):
+
+- plain passes first; Newton only once plain passes contract slowly (residual ratio above
+  0.3 after at least two passes).  A loop that shakes down to pure stick after one slipping
+  pass keeps that stick state (the periodic state is not unique there: any stuck slider
+  position repeats; Newton from the first pass would jump to another one);
+- when the state has closed but the seeds have not (a direction that contracts slowly, e.g.
+  the transverse force of a contact slipping along a line: the state is exactly periodic
+  after one pass, its derivative is not), one Newton update of the seeds alone and a last
+  pass give the derivative of the periodic solution rather than of a finite number of passes;
+- when ``I - M`` is singular (cond > 1e12: a direction that never slips keeps its start
+  value, the rest-state convention) or a Newton step does not reduce the residual, plain
+  passes are used.
+
+The forces of the last pass, which starts from the closed state, are returned.
+"""
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+from .kernels import law_step, law_init, _accumulate
+
+
+@nb.njit(cache=True)
+def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
+    """Same interface as :func:`elements.kernels.march`, with Newton closure (module doc)."""
+    N, nz = z.shape
+    P = dz.shape[2]
+    ns = n_state
+    s = np.zeros(ns)
+    s_new = np.zeros(ns)
+    s_begin = np.zeros(ns)
+    ds = np.zeros((ns, P))
+    ds_new = np.zeros((ns, P))
+    ds_begin = np.zeros((ns, P))
+    Ms = np.zeros((ns, ns))
+    Ms_new = np.zeros((ns, ns))
+    A = np.zeros((ns, ns))
+    B = np.zeros((ns, nz))
+    law_init(kind, p, z[start], s, B)
+    _accumulate(B, dz[start], ds)
+    f = np.empty((N, n_local))
+    df = np.empty((N, n_local, P))
+    passes = 0
+    closed = False
+    last_res = np.inf
+    newton_ok = True
+    seeds_fixed = False
+    eye = np.eye(ns)
+    while passes < max_passes and not closed:
+        passes += 1
+        s_begin[:] = s
+        ds_begin[:, :] = ds
+        Ms[:, :] = eye
+        for jj in range(1, N + 1):
+            j = (start + jj) % N
+            law_step(kind, p, s, z[j], s_new, A, B)
+            ds_new[:, :] = 0.0
+            _accumulate(A, ds, ds_new)
+            _accumulate(B, dz[j], ds_new)
+            Ms_new[:, :] = 0.0
+            _accumulate(A, Ms, Ms_new)
+            s, s_new = s_new, s
+            ds, ds_new = ds_new, ds
+            Ms, Ms_new = Ms_new, Ms
+            for a in range(n_local):
+                f[j, a] = s[a]
+                for c in range(P):
+                    df[j, a, c] = ds[a, c]
+        scale = 0.0
+        res = 0.0
+        for i in range(ns):
+            scale = max(scale, abs(s[i]), abs(s_begin[i]))
+            res = max(res, abs(s[i] - s_begin[i]))
+        dscale = 0.0
+        dres = 0.0
+        for i in range(ns):
+            for c in range(P):
+                dscale = max(dscale, abs(ds[i, c]), abs(ds_begin[i, c]))
+                dres = max(dres, abs(ds[i, c] - ds_begin[i, c]))
+        state_closed = res <= tol * scale or scale == 0.0
+        seeds_closed = dres <= 1e3 * tol * dscale or dscale == 0.0
+        if state_closed and (seeds_closed or seeds_fixed):
+            closed = True
+            break
+        K = eye - Ms
+        singular = np.linalg.cond(K) > 1e12
+        if state_closed:
+            if singular:
+                closed = True
+                break
+            # periodic state, non-periodic seeds: solve the affine seed map once, then re-record
+            ds[:, :] = ds_begin + np.linalg.solve(K, ds - ds_begin)
+            seeds_fixed = True
+            continue
+        slow = passes >= 2 and res > 0.3 * last_res
+        if res >= last_res and passes > 2:
+            newton_ok = False
+        last_res = res
+        if slow and newton_ok and not singular:
+            s[:] = s_begin + np.linalg.solve(K, s - s_begin)
+            ds[:, :] = ds_begin + np.linalg.solve(K, ds - ds_begin)
+    if not closed:
+        passes = -passes
+    return f, df, passes

@@ -1,0 +1,96 @@
+"""Coulomb friction element classes on one coordinate (laws in laws/coulomb.py)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Element, coordinate_rows, require_keys, positive, non_negative
+from .kinds import COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
+from .laws.coulomb import LINEAR, ARCTAN
+
+
+class CoulombStickSlip(Element):
+    """Coulomb friction with a static coefficient above the kinetic one (seed 000).
+
+    Case keys: ``type``, ``dofs`` (``[a]`` or ``[a, b]``), ``kt`` (stick stiffness, > 0),
+    ``normal_load`` (N >= 0), ``mu_static`` (>= 0), ``mu_kinetic`` (0 <= mu_k <= mu_s),
+    optional ``name``.  State ``[f, u_prev, sliding]``.
+
+    The march starts at the displacement maximum (a reversal), from the rest state reached
+    there from ``q = 0``.  With ``mu_s > mu_k`` the law has two periodic states for some
+    amplitudes (pure stick, and a stick-slip loop once broken loose); this start picks pure
+    stick whenever ``kt max(u) <= mu_s N``, i.e. the state reached by loading from rest.
+    """
+
+    kind = COULOMB_STATIC_KINETIC
+    n_state = 3
+    velocity = False
+    needs_mean = False
+    coord_names = ("u",)
+    keys = ("type", "dofs", "kt", "normal_load", "mu_static", "mu_kinetic", "name")
+
+    def __init__(self, gather, kt, normal_load, mu_static, mu_kinetic, name="coulomb_stick_slip"):
+        mu_s = non_negative("mu_static", mu_static)
+        mu_k = non_negative("mu_kinetic", mu_kinetic)
+        if mu_k > mu_s:
+            raise ValueError(f"{name}: mu_kinetic ({mu_k}) must not exceed mu_static ({mu_s})")
+        super().__init__(gather, np.array([positive("kt", kt), non_negative("normal_load", normal_load),
+                                           mu_s, mu_k]), name)
+
+    @classmethod
+    def from_spec(cls, spec, n_dof, dof_index=None, where="element"):
+        require_keys(spec, cls.keys, ("dofs", "kt", "normal_load", "mu_static", "mu_kinetic"), where)
+        G = coordinate_rows([spec["dofs"]], n_dof, dof_index, where)
+        return cls(G, spec["kt"], spec["normal_load"], spec["mu_static"], spec["mu_kinetic"],
+                   spec.get("name", "coulomb_stick_slip"))
+
+    def start_index(self, u):
+        return int(np.argmax(u[:, 0]))
+
+    def linear_stiffness(self):
+        stuck = self.params[1] * self.params[2] > 0.0
+        return np.array([[self.params[0] if stuck else 0.0]])
+
+
+class CoulombRegularised(Element):
+    """Velocity-regularised Coulomb friction (seed 001, eq. 2.2), memory-less in ``u``.
+
+    ``f = Ft0 sat(v / v_r)`` (``law = "linear"``) or ``f = Ft0 (2/pi) arctan(v / v_r)``
+    (``law = "arctan"``).  Case keys: ``type``, ``dofs``, ``slip_force`` (Ft0 >= 0),
+    ``v_r`` (> 0), ``law`` (default ``"linear"``), optional ``name``.  Inputs ``[u, v]``;
+    state ``[f]``.
+    """
+
+    kind = COULOMB_REGULARISED
+    n_state = 1
+    velocity = True
+    needs_mean = False
+    coord_names = ("u",)
+    keys = ("type", "dofs", "slip_force", "v_r", "law", "name")
+    laws = {"linear": LINEAR, "arctan": ARCTAN}
+
+    def __init__(self, gather, slip_force, v_r, law="linear", name="coulomb_regularised"):
+        if law not in self.laws:
+            raise ValueError(f"{name}: law must be one of {', '.join(self.laws)}, got {law!r}")
+        super().__init__(gather, np.array([non_negative("slip_force", slip_force), positive("v_r", v_r),
+                                           float(self.laws[law])]), name)
+        self.law = law
+
+    @classmethod
+    def from_spec(cls, spec, n_dof, dof_index=None, where="element"):
+        require_keys(spec, cls.keys, ("dofs", "slip_force", "v_r"), where)
+        G = coordinate_rows([spec["dofs"]], n_dof, dof_index, where)
+        return cls(G, spec["slip_force"], spec["v_r"], spec.get("law", "linear"),
+                   spec.get("name", "coulomb_regularised"))
+
+    def start_index(self, u):
+        return 0
+
+    def linear_stiffness(self):
+        return np.zeros((1, 1))
+
+    def linear_damping(self):
+        """Viscous tangent at rest, ``df/dv`` at ``v = 0``: ``Ft0 / v_r`` (linear) or
+        ``2 Ft0 / (pi v_r)`` (arctan)."""
+        F0, vr = self.params[0], self.params[1]
+        c = F0 / vr if self.law == "linear" else 2.0 * F0 / (np.pi * vr)
+        return np.array([[c]])

@@ -1,0 +1,283 @@
+"""friction3d: exact marched Jacobian, reduction to Jenkins, 2D gross slip on a circle,
+variable normal load against a sequential time march, separation, case keys."""
+import numpy as np
+import pytest
+
+from elements import ELEMENTS, Friction3D, Jenkins
+from elements.kernels import law_step
+from elements.closure import march_newton
+from hbm.fourier import FourierBasis
+
+KT, KN, MU, N0 = 1.0, 2.0, 0.5, 1.0       # mu N0 / kt = 0.5
+
+
+def make(nt=2, kt=KT, kn=KN, mu=MU, n0=N0):
+    return Friction3D(np.eye(nt + 1), kt=kt, kn=kn, mu=mu, normal_preload=n0)
+
+
+def run(el, z, dz=None):
+    """March through the element's closure kernel directly so that the closure is asserted."""
+    z = np.ascontiguousarray(z, dtype=float)
+    if dz is None:
+        dz = np.zeros(z.shape + (1,))
+    f, df, passes = march_newton(el.kind, el.params, el.n_state, el.n_local, z, np.ascontiguousarray(dz),
+                          el.start_index(z[:, :el.n_local]), el.max_passes, el.closure_tol)
+    assert passes > 0, "loop did not close"
+    return f, df
+
+
+def coeff_march(el, basis, X):
+    """F = P f(E X) and dF/dX (n_coef, nloc, n_coef * nloc) from the seeded march."""
+    nloc = el.n_local
+    z = basis.E @ X
+    nc = basis.n_coef
+    dz = np.zeros((basis.n_samples, nloc, nc * nloc))
+    for k in range(nc):
+        for a in range(nloc):
+            dz[:, a, k * nloc + a] = basis.E[:, k]
+    f, df = run(el, z, dz)
+    return basis.P @ f, np.einsum("kj,jap->kap", basis.P, df), f, z
+
+
+def fd_error(el, basis, X, rel_step=1e-6):
+    F, dF, f, z = coeff_march(el, basis, X)
+    h = rel_step * np.abs(X).max()
+    x = X.reshape(-1)
+    fd = np.empty_like(dF)
+    for p in range(x.size):
+        xp = x.copy()
+        xp[p] += h
+        xm = x.copy()
+        xm[p] -= h
+        Fp = coeff_march(el, basis, xp.reshape(X.shape))[0]
+        Fm = coeff_march(el, basis, xm.reshape(X.shape))[0]
+        fd[:, :, p] = (Fp - Fm) / (2 * h)
+    return np.abs(dF - fd).max() / np.abs(fd).max(), el.summary(f, z)
+
+
+BASIS = FourierBasis(np.array([0, 1, 2, 3]), 64)
+
+
+def random_coeffs(rng, amps, mean=0.05):
+    """Random coefficients (n_coef, nloc) with amplitudes ``amps`` per coordinate."""
+    decay = np.array([mean, 1, 1, 0.3, 0.3, 0.1, 0.1])[:, None]
+    return rng.standard_normal((BASIS.n_coef, len(amps))) * decay * np.asarray(amps)[None, :]
+
+
+def ellipse_coeffs(a1, a2, phase, an, phase_n, rng, nt=2):
+    """First-harmonic ellipse in (t1, t2), normal motion, plus a little random 2nd/3rd harmonic."""
+    X = 0.03 * random_coeffs(rng, [a1, a2, an][-(nt + 1):] if nt == 2 else [a1, an])
+    c, s = BASIS.row_of(1, "c"), BASIS.row_of(1, "s")
+    X[c, 0] += a1
+    if nt == 2:
+        X[c, 1] += a2 * np.cos(phase)
+        X[s, 1] -= a2 * np.sin(phase)
+    X[c, -1] += an * np.cos(phase_n)
+    X[s, -1] -= an * np.sin(phase_n)
+    return X
+
+
+PATHS = ["stick2d", "slip1d", "mixed1d", "mixed2d", "separation1d", "separation2d", "line3d"]
+
+
+@pytest.mark.parametrize("case", PATHS)
+def test_fd_jacobian_paths(case):
+    rng = np.random.default_rng(100 + PATHS.index(case))
+    if case == "stick2d":
+        el, X = make(2), random_coeffs(rng, [0.08, 0.08, 0.05])
+    elif case == "slip1d":
+        el, X = make(1), ellipse_coeffs(3.0, 0, 0, 0.1, 0.4, rng, nt=1)
+    elif case == "mixed1d":
+        el, X = make(1), ellipse_coeffs(0.6, 0, 0, 0.25, 0.7, rng, nt=1)
+    elif case == "mixed2d":
+        el, X = make(2), ellipse_coeffs(0.9, 0.5, 1.1, 0.2, 2.0, rng)
+    elif case == "separation1d":
+        el, X = make(1), ellipse_coeffs(0.8, 0, 0, 0.9, 0.3, rng, nt=1)
+    elif case == "separation2d":
+        el, X = make(2), ellipse_coeffs(0.8, 0.6, 0.7, 0.9, 2.5, rng)
+    else:
+        # 3D contact slipping along a line (no t2 motion): the state is periodic after one
+        # pass but the transverse derivative is not; closure must converge the seeds too
+        el, X = make(2), ellipse_coeffs(1.5, 0.0, 0.0, 0.1, 0.5, rng)
+        X[:, 1] = 0.0
+    err, summ = fd_error(el, BASIS, X)
+    # the path really is of the advertised kind
+    if case.startswith("stick"):
+        assert summ["slip_fraction"] == 0.0 and summ["open_fraction"] == 0.0
+    elif case.startswith("slip") or case == "line3d":
+        assert summ["slip_fraction"] > 0.5 and summ["open_fraction"] == 0.0
+    elif case.startswith("mixed"):
+        assert 0.0 < summ["slip_fraction"] < 1.0 and summ["open_fraction"] == 0.0
+    else:
+        assert 0.0 < summ["open_fraction"] < 1.0 and summ["slip_fraction"] > 0.0
+    assert err < 1e-6, (case, err)
+
+
+@pytest.mark.parametrize("phase", [0.3, np.pi / 4, np.pi / 2, 2.4])
+def test_fd_jacobian_elliptical_phases(phase):
+    rng = np.random.default_rng(7)
+    el = make(2)
+    X = ellipse_coeffs(1.0, 0.7, phase, 0.15, 1.3, rng)
+    err, summ = fd_error(el, BASIS, X)
+    assert summ["slip_fraction"] > 0.0
+    assert err < 1e-6, (phase, err)
+
+
+def test_reduces_to_jenkins():
+    """u_n = 0 and only t1 moving: same forces as Jenkins(kt, mu N0), in 2D and 3D variants."""
+    N = 128
+    th = 2 * np.pi * np.arange(N) / N
+    jen = Jenkins(np.eye(1), kt=KT, slip_force=MU * N0)
+    for amp in (0.3, 0.7, 2.0):          # stick, mixed, gross slip
+        u = amp * np.cos(th) + 0.2 * amp * np.sin(3 * th + 0.4)
+        fj, _ = jen.march(u[:, None], np.zeros((N, 1, 1)))
+        for nt in (1, 2):
+            z = np.zeros((N, nt + 1))
+            z[:, 0] = u
+            f, _ = run(make(nt), z)
+            np.testing.assert_allclose(f[:, 0], fj[:, 0], rtol=0, atol=1e-14)
+            assert np.all(f[:, 1:] == 0.0)
+
+
+def test_circular_gross_slip():
+    r"""Circle of radius R, kt R > mu N: |f| = mu N at every sample, rotating with the motion.
+
+    Steady state: the slider moves on a circle of radius r with its velocity (tangent to that
+    circle) along f = kt (u - w), so u - w is perpendicular to w and
+    r = sqrt(R^2 - (mu N / kt)^2); the dissipation per cycle is 2 pi mu N r.
+    (Not R - mu N / kt: the slider trails the contact point by a quarter turn of the force.)
+    On N samples (step angle D = 2 pi / N) the return mapping puts w_{j-1}, w_j and u_j on one
+    line, so u - w_j is perpendicular to the chord bisector instead of to w_j; with
+    c = mu N / kt this gives R^2 = r_N^2 + 2 r_N c sin(D/2) + c^2, i.e.
+    r_N = sqrt(R^2 - c^2 cos^2(D/2)) - c sin(D/2) (first order in 1/N), and the slider
+    polygon is regular: dissipation exactly mu N * N * 2 r_N sin(D/2).
+    """
+    R, n = 1.0, 256
+    th = 2 * np.pi * np.arange(n) / n
+    el = make(2)
+    z = np.stack([R * np.cos(th), R * np.sin(th), np.zeros(n)], axis=1)
+    f, _ = run(el, z)
+    mun = MU * N0
+    np.testing.assert_allclose(np.hypot(f[:, 0], f[:, 1]), mun, rtol=1e-12)
+    lag = np.angle(np.exp(1j * (np.arctan2(f[:, 1], f[:, 0]) - th)))
+    assert np.ptp(lag) < 1e-9
+    summ = el.summary(f, z)
+    assert summ["slip_fraction"] == 1.0
+    w = z[:, :2] - f[:, :2] / KT
+    r_n = np.hypot(w[:, 0], w[:, 1])
+    assert np.ptp(r_n) < 1e-12
+    np.testing.assert_allclose(summ["dissipation"], mun * n * 2 * r_n[0] * np.sin(np.pi / n), rtol=1e-10)
+    c, sh = mun / KT, np.sin(np.pi / n)
+    np.testing.assert_allclose(r_n, np.sqrt(R ** 2 - c ** 2 * (1 - sh ** 2)) - c * sh, rtol=1e-12)
+    r = np.sqrt(R ** 2 - c ** 2)
+    e_cont = 2 * np.pi * mun * r
+    rel = abs(summ["dissipation"] - e_cont) / e_cont
+    assert rel < 1.2 * c * np.pi / (n * r)          # first-order discretisation error only
+    assert abs(summ["dissipation"] - 2 * np.pi * mun * (R - c)) > 0.3 * e_cont    # not R - mu N/kt
+    # the trapezoidal work of f on the contact point agrees (all of it is dissipated)
+    work = np.sum(0.5 * (f + np.roll(f, 1, 0))[:, :2] * (z - np.roll(z, 1, 0))[:, :2])
+    assert abs(work - e_cont) / e_cont < 1.2 * c * np.pi / (n * r)
+
+
+def time_march(el, z, periods):
+    """Sequential steps of the same law_step from the rest state at q = 0."""
+    s = np.zeros(el.n_state)
+    s_new = np.zeros(el.n_state)
+    A = np.zeros((el.n_state, el.n_state))
+    B = np.zeros((el.n_state, z.shape[1]))
+    out = np.empty((z.shape[0], el.n_local))
+    for _ in range(periods):
+        for j in range(z.shape[0]):
+            law_step(el.kind, el.params, s, np.ascontiguousarray(z[j]), s_new, A, B)
+            s, s_new = s_new, s
+            out[j] = s[:el.n_local]
+    return out
+
+
+def test_variable_normal_load_against_time_march():
+    """Normal load in phase with t1: asymmetric loop; the march equals time stepping."""
+    n = 128
+    th = 2 * np.pi * np.arange(n) / n
+    el = make(1)
+    z = np.stack([1.5 * np.cos(th), 0.3 * np.cos(th)], axis=1)
+    f, _ = run(el, z)
+    assert f[:, 0].max() > 1.3 * -f[:, 0].min()     # mu N is larger while u_t > 0
+    np.testing.assert_allclose(f[:, 0].max(), MU * (N0 + KN * 0.3), rtol=1e-12)
+    jmin = np.argmin(z[:, 0])                        # slipping at the lower reversal, smallest N
+    np.testing.assert_allclose(f[jmin, 0], -MU * (N0 - KN * 0.3), rtol=1e-12)
+    ft = time_march(el, z, 4)
+    np.testing.assert_allclose(ft, f, rtol=0, atol=1e-12)
+    e_march, e_time = el.summary(f, z)["dissipation"], el.summary(ft, z)["dissipation"]
+    assert e_march > 0
+    assert abs(e_march - e_time) <= 1e-10 * e_march
+
+
+def test_variable_normal_load_2d_against_time_march():
+    n = 64
+    th = 2 * np.pi * np.arange(n) / n
+    el = make(2)
+    z = np.stack([1.2 * np.cos(th), 0.8 * np.sin(th + 0.5), 0.25 * np.cos(th + 0.3)], axis=1)
+    f, _ = run(el, z)
+    ft = time_march(el, z, 200)
+    np.testing.assert_allclose(ft, f, rtol=0, atol=1e-10)
+    e_march, e_time = el.summary(f, z)["dissipation"], el.summary(ft, z)["dissipation"]
+    assert abs(e_march - e_time) <= 1e-10 * e_march
+
+
+def test_separation_forces():
+    """Open samples: f_t = 0 and f_n = -N0 exactly; re-contact re-sticks unloaded."""
+    n0, n = 0.1, 128
+    th = 2 * np.pi * np.arange(n) / n
+    el = make(2, n0=n0)
+    z = np.stack([0.8 * np.cos(th + 0.2), 0.5 * np.sin(th), 1.0 * np.cos(th)], axis=1)
+    f, _ = run(el, z)
+    open_ = n0 + KN * z[:, 2] <= 0
+    assert 0.3 < open_.mean() < 0.7
+    assert np.all(f[open_, :2] == 0.0)
+    assert np.all(f[open_, 2] == -n0)
+    np.testing.assert_allclose(f[~open_, 2], KN * z[~open_, 2], rtol=1e-14)
+    summ = el.summary(f, z)
+    assert summ["open_fraction"] == open_.mean()
+    assert summ["normal_load_min"] == 0.0
+    np.testing.assert_allclose(summ["normal_load_max"], n0 + KN, rtol=1e-12)
+    # first closed sample after the gap: trial force kt (u_j - u_{j-1}) from zero
+    j = next(j for j in range(n) if open_[j - 1] and not open_[j])
+    trial = KT * (z[j, :2] - z[j - 1, :2])
+    limit = MU * (n0 + KN * z[j, 2])
+    expect = trial if np.linalg.norm(trial) <= limit else limit * trial / np.linalg.norm(trial)
+    np.testing.assert_allclose(f[j, :2], expect, rtol=1e-13)
+
+
+def test_rest_is_force_free_and_init():
+    el = make(2)
+    z = np.zeros((16, 3))
+    f, _ = run(el, z)
+    assert np.all(f == 0.0)
+    assert el.needs_mean and not el.velocity and el.n_state == 5
+    np.testing.assert_array_equal(el.linear_stiffness(), np.diag([KT, KT, KN]))
+
+
+def test_from_spec_keys_and_validation():
+    cls = ELEMENTS["friction3d"]
+    assert cls is Friction3D
+    spec = {"type": "friction3d", "dofs": {"t1": [3, 0], "t2": [4, 1], "n": [5, 2]},
+            "kt": 1e6, "kn": 2e6, "mu": 0.5, "normal_preload": 100.0, "name": "c1"}
+    el = cls.from_spec(spec, 6)
+    assert el.n_local == 3 and el.name == "c1" and el.n_state == 5
+    G = np.zeros((3, 6))
+    G[0, 3], G[0, 0], G[1, 4], G[1, 1], G[2, 5], G[2, 2] = 1, -1, 1, -1, 1, -1
+    np.testing.assert_array_equal(el.gather, G)
+    el2 = cls.from_spec({**spec, "dofs": {"t1": "a", "n": ["b"]}}, 6, dof_index={"a": 1, "b": 2})
+    assert el2.n_local == 2 and el2.coord_names == ("t1", "n") and el2.n_state == 3
+    np.testing.assert_array_equal(el2.gather[:, :3], [[0, 1, 0], [0, 0, 1]])
+    with pytest.raises(ValueError, match="'friction'"):
+        cls.from_spec({**spec, "friction": 0.3}, 6)
+    with pytest.raises(ValueError, match="'t3'"):
+        cls.from_spec({**spec, "dofs": {"t1": 0, "t3": 1, "n": 2}}, 6)
+    with pytest.raises(ValueError, match="'n'"):
+        cls.from_spec({**spec, "dofs": {"t1": 0}}, 6)
+    with pytest.raises(ValueError, match="'normal_preload'"):
+        cls.from_spec({k: v for k, v in spec.items() if k != "normal_preload"}, 6)
+    for key, bad in (("kt", 0.0), ("kn", -1.0), ("mu", -0.1), ("normal_preload", -5.0)):
+        with pytest.raises(ValueError, match=key):
+            cls.from_spec({**spec, key: bad}, 6)
