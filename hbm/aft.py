@@ -15,7 +15,7 @@ and the Jacobian follows from the same march with forward-mode seeds
 
     \frac{\partial F_{nl}}{\partial X_{nl}} = (I \otimes G^T)\, P\, \frac{\partial f}{\partial U}\,(I \otimes G),
 
-assembled by contraction with the small dense ``G`` (never as a Kronecker product).
+assembled by batched products with the small dense ``G`` (never as a Kronecker product).
 Only the DOFs touched by an element (the nonlinear DOFs) enter the AFT.
 """
 from __future__ import annotations
@@ -128,8 +128,9 @@ class NonlinearForces:
             dFe = self.transform.analyse(df.reshape(N, nl * Pcols)).reshape(nc, nl, Pcols)
             F += Fe @ G
             dFdw += dFe[:, :, -1] @ G
-            dU = dFe[:, :, :-1].reshape(nc, nl, nc, nl)
-            J4 += np.einsum("kalb,ai,bj->kilj", dU, G, G, optimize=True)
+            # (G^T dU G) on the DOF axes, batched over the coefficient pairs
+            dU = dFe[:, :, :-1].reshape(nc, nl, nc, nl).transpose(0, 2, 1, 3)
+            J4 += (G.T @ dU @ G).transpose(0, 2, 1, 3)
         return F, J4.reshape(nc * nn, nc * nn), dFdw
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:

@@ -54,23 +54,41 @@ class HarmonicBalance:
             r += nr
         idx = (np.arange(basis.n_coef)[:, None] * n + self.nl.dofs[None, :]).ravel()
         self._nl_index = idx
+        h = basis.h_of_row
+        self._rows = np.arange(h.size)
+        self._h2 = (h * h).astype(float)
+        self._rows_c = np.array([r for r in range(h.size) if h[r] > 0 and (r == 0 or h[r - 1] != h[r])],
+                                dtype=np.int64)
+        self._rows_s = self._rows_c + 1
+        self._h_c = h[self._rows_c].astype(float)
 
     @property
     def n_unknowns(self) -> int:
         return self.basis.n_coef * self.n_dof
 
     def linear_part(self, X: np.ndarray, w: float):
-        """``Z(w) X`` (n_coef, n), ``Z(w)`` dense (n_u, n_u) and ``Z'(w) X`` (n_coef, n)."""
-        blocks, dblocks = harmonic_blocks(self.model, self.basis, w)
-        x = X.reshape(-1)
-        ZX = np.empty_like(x)
-        dZX = np.empty_like(x)
-        Z = np.zeros((x.size, x.size))
-        for s, B, dB in zip(self._slices, blocks, dblocks):
-            ZX[s] = B @ x[s]
-            dZX[s] = dB @ x[s]
-            Z[s, s] = B
-        return ZX.reshape(X.shape), Z, dZX.reshape(X.shape)
+        """``Z(w) X`` (n_coef, n), ``Z(w)`` dense (n_u, n_u) and ``Z'(w) X`` (n_coef, n).
+
+        Per coefficient row ``r`` of harmonic ``h_r``: ``(Z X)_r = K X_r + w C (D X)_r
+        - w^2 h_r^2 M X_r`` (``D`` the derivative operator), evaluated for all rows at
+        once; ``Z`` is filled harmonic block by harmonic block through a 4-D view.
+        """
+        M, C, K = self.model.M, self.model.C, self.model.K
+        h2X = self._h2[:, None] * X
+        DX = self.basis.D @ X
+        ZX = X @ K + w * (DX @ C) - (w * w) * (h2X @ M)
+        dZX = DX @ C - (2.0 * w) * (h2X @ M)
+        nc, n = X.shape
+        Z = np.zeros((nc * n, nc * n))
+        Z4 = Z.reshape(nc, n, nc, n)
+        r = self._rows
+        Z4[r, :, r, :] = K[None] - (w * w) * self._h2[:, None, None] * M[None]
+        rc, rs, hc = self._rows_c, self._rows_s, self._h_c
+        if rc.size:
+            wC = (w * hc)[:, None, None] * C[None]
+            Z4[rc, :, rs, :] = wC
+            Z4[rs, :, rc, :] = -wC
+        return ZX, Z, dZX
 
     def residual(self, X: np.ndarray, w: float):
         """Residual and Jacobians.
