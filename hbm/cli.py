@@ -153,7 +153,8 @@ def cmd_timesim(args) -> int:
     write_timesim(case, res, args.out)
     n = opts.steps
     if res.mode == "steady":
-        how = (f"steady state after {res.periods} periods ({res.coarse.periods} at n={n}, "
+        state = "steady state after" if res.converged else "NOT periodic after"
+        how = (f"{state} {res.periods} periods ({res.coarse.periods} at n={n}, "
                f"{res.fine.periods} at 2n={2 * n})")
     else:
         off = "" if res.switch_off_at is None else f", force off after {res.switch_off_at:g} s"
