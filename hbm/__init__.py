@@ -14,4 +14,10 @@ def frf(case, harmonics=None, samples=None, fmin=None, fmax=None, **kwargs):
     return _frf(case, harmonics=harmonics, samples=samples, fmin=fmin, fmax=fmax, **kwargs)
 
 
-__all__ = ["Case", "CaseError", "load_case", "frf"]
+def timesim(case, freq_hz, options=None, **kwargs):
+    """Time-domain reference at one frequency; see :func:`hbm.timesim.timesim`."""
+    from .timesim import timesim as _timesim
+    return _timesim(case, freq_hz, options, **kwargs)
+
+
+__all__ = ["Case", "CaseError", "load_case", "frf", "timesim"]

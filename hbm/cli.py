@@ -1,4 +1,8 @@
-"""Command line: ``hbm frf CASE.toml -o OUTDIR [--harmonics H] [--samples N] [--fmin F] [--fmax F]``.
+"""Command line.
+
+``hbm frf CASE.toml -o OUTDIR [--harmonics H] [--samples N] [--fmin F] [--fmax F]``;
+``hbm timesim CASE.toml --freq-hz F -o OUTDIR [--steps N] [--tol T] [--max-periods P]
+[--periods P --switch-off-at S] [--alpha A]``.
 
 Thin: parse, load the case, call the library, write results.  Bad input prints one line on
 stderr and exits with status 2; a solver failure keeps the points computed and exits 1.
@@ -62,6 +66,17 @@ def build_parser():
     f.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     f.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     _add_analysis_options(f)
+    t = sub.add_parser("timesim", help="time-domain reference at one frequency (steady state or transient)")
+    t.add_argument("case", help="case file (TOML)")
+    t.add_argument("--freq-hz", type=float, required=True, help="excitation frequency, Hz")
+    t.add_argument("-o", "--out", default="out", help="output folder (default: out)")
+    t.add_argument("--steps", type=_positive_int, help="time steps per period n (default 512; the estimate runs 2n)")
+    t.add_argument("--tol", type=_positive_float, help="periodicity tolerance (default 1e-8)")
+    t.add_argument("--max-periods", type=_positive_int, help="most periods per run (default 5000)")
+    t.add_argument("--periods", type=_positive_int, help="transient mode: integrate this many periods from rest")
+    t.add_argument("--switch-off-at", type=float, help="transient mode: force off after this time, s")
+    t.add_argument("--alpha", type=float, help="HHT alpha in [-1/3, 0] (default 0: Newmark average acceleration)")
+    t.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     return p
 
 
@@ -96,7 +111,68 @@ def cmd_frf(args) -> int:
     return 0
 
 
-COMMANDS = {"frf": cmd_frf}
+def cmd_timesim(args) -> int:
+    import dataclasses
+    import math
+    import time
+    from .timesim import TimeSimOptions, timesim
+    from .timesim_report import write_timesim
+    f = args.freq_hz
+    if not (math.isfinite(f) and f > 0):
+        raise CaseError(f"--freq-hz must be a positive frequency in Hz, got {f:g}")
+    if args.switch_off_at is not None:
+        if args.periods is None:
+            raise CaseError("--switch-off-at needs --periods (transient mode)")
+        if not (math.isfinite(args.switch_off_at) and args.switch_off_at >= 0):
+            raise CaseError(f"--switch-off-at must be a time >= 0 s, got {args.switch_off_at:g}")
+    over = {k: v for k, v in (("steps", args.steps), ("tol", args.tol), ("max_periods", args.max_periods),
+                               ("alpha", args.alpha)) if v is not None}
+    opts = dataclasses.replace(TimeSimOptions(), **over)
+    opts.validate()
+    case = load_case(args.case)
+    t_start = time.perf_counter()
+    shown = [False]
+
+    def progress(periods, change):
+        if args.quiet or time.perf_counter() - t_start < 1.0:
+            return
+        ch = f", change {change:.1e}" if change >= 0 else ""
+        sys.stderr.write(f"\r  timesim: {periods} periods{ch}   ")
+        sys.stderr.flush()
+        shown[0] = True
+
+    try:
+        res = timesim(case, f, opts, periods=args.periods, switch_off_at=args.switch_off_at, progress=progress)
+    except RuntimeError as exc:
+        if shown[0]:
+            sys.stderr.write("\n")
+        sys.stderr.write(f"hbm: timesim failed: {exc}\n")
+        return 1
+    if shown[0]:
+        sys.stderr.write("\r" + " " * 50 + "\r")
+    write_timesim(case, res, args.out)
+    n = opts.steps
+    if res.mode == "steady":
+        state = "steady state after" if res.converged else "NOT periodic after"
+        how = (f"{state} {res.periods} periods ({res.coarse.periods} at n={n}, "
+               f"{res.fine.periods} at 2n={2 * n})")
+    else:
+        off = "" if res.switch_off_at is None else f", force off after {res.switch_off_at:g} s"
+        how = f"transient over {res.periods} periods{off}"
+    print(f"{case.name}: {f:.6g} Hz, {how}, {res.seconds:.3f} s")
+    for name in case.analysis.outputs:
+        print(f"  {name}: h1 {res.h1[name]:.6g}  max {res.max[name]:.6g}")
+    print(f"  error estimate {res.error_estimate:.2e} (relative change n={n} -> 2n={2 * n} steps per period)")
+    print(f"  wrote {args.out}/timesim.csv, history.csv, timesim.png")
+    if not res.converged:
+        sys.stderr.write(f"hbm: timesim: no periodic steady state within {opts.max_periods} periods "
+                         f"(last relative change {max(res.coarse.change, res.fine.change):.2e} > tol {opts.tol:g}); "
+                         f"results are of the last period\n")
+        return 1
+    return 0
+
+
+COMMANDS = {"frf": cmd_frf, "timesim": cmd_timesim}
 
 
 def main(argv=None) -> int:

@@ -1,0 +1,80 @@
+"""Write a time-domain result: ``timesim.csv``, ``history.csv`` and ``timesim.png``.
+
+``timesim.csv``: one header row ``freq_hz``, ``NAME_h1``, ``NAME_max`` per output,
+``error_estimate``, ``periods``; one data row.  ``history.csv``: ``t``, then every output,
+then every element force component (the last period in steady mode, everything in transient
+mode).
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+
+def write_summary_csv(case, res, path: Path) -> None:
+    names = list(case.analysis.outputs)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")]
+                   + ["error_estimate", "periods"])
+        row = [f"{res.freq_hz:.10g}"]
+        for n in names:
+            row += [f"{res.h1[n]:.10g}", f"{res.max[n]:.10g}"]
+        row += [f"{res.error_estimate:.3e}", str(int(res.periods))]
+        w.writerow(row)
+
+
+def write_history_csv(case, res, path: Path) -> None:
+    hist = res.history
+    outs = case.analysis.outputs
+    cols = [hist.t] + [hist.q[:, d] for d in outs.values()] + [hist.forces[:, i] for i in range(hist.forces.shape[1])]
+    data = np.column_stack(cols)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["t"] + list(outs) + list(hist.force_names))
+        for r in data:
+            w.writerow([f"{x:.10g}" for x in r])
+
+
+def write_plot(case, res, path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    hist = res.history
+    n_f = hist.forces.shape[1]
+    fig, axes = plt.subplots(1, 2 if n_f else 1, figsize=(11 if n_f else 7, 4.2), squeeze=False)
+    ax = axes[0, 0]
+    for name, dof in case.analysis.outputs.items():
+        ax.plot(hist.t, hist.q[:, dof], lw=0.9, label=name)
+    if res.switch_off_at is not None:
+        ax.axvline(res.switch_off_at, color="0.5", ls=":", lw=0.8, label="force off")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("displacement")
+    what = "steady-state period" if res.mode == "steady" else "transient"
+    ax.set_title(f"{case.name}: {what} at {res.freq_hz:.6g} Hz", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    if n_f:
+        ax = axes[0, 1]
+        for i, name in enumerate(hist.force_names):
+            ax.plot(hist.disp[:, i], hist.forces[:, i], lw=0.9, label=name)
+        ax.set_xlabel("element coordinate u")
+        ax.set_ylabel("element force f")
+        ax.set_title("hysteresis (force against displacement)", fontsize=9)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_timesim(case, res, outdir) -> Path:
+    """Write the three files into ``outdir`` (created); returns the folder."""
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_summary_csv(case, res, out / "timesim.csv")
+    write_history_csv(case, res, out / "history.csv")
+    write_plot(case, res, out / "timesim.png")
+    return out
