@@ -134,8 +134,11 @@ class NonlinearForces:
         return F, J4.reshape(nc * nn, nc * nn), dFdw
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:
-        """Forces only, (n_coef, n_nl) (no derivative propagation needed by the caller)."""
-        return self.evaluate(Xnl, w)[0]
+        """Forces only, (n_coef, n_nl): the march runs with a single zero seed."""
+        F = np.zeros((self.basis.n_coef, self.n_nl))
+        for i, (z, f) in enumerate(self.element_forces(Xnl, w)):
+            F += self.transform.analyse(f) @ self._G[i]
+        return F
 
     def element_forces(self, Xnl: np.ndarray, w: float):
         """Per element: sampled inputs ``z`` (N, n_input) and forces ``f`` (N, n_local)."""

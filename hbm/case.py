@@ -6,8 +6,10 @@ Schema (``../shared/DESIGN.md``)::
     [model]       mass, stiffness, damping | rayleigh | modal_damping, dof_names   (or file = "x.npz")
     [[element]]   type = "<registry key>", dofs = ..., law keys
     [excitation]  dofs = [...], amplitude = [...]        (cosine at the first harmonic, N)
+                  base = { dofs = [...], amplitude = [...] }   (imposed support motion, m)
     [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], outputs = {name = dof},
                   max_points, transform
+                  (an output is a DOF index or name, or [a, b] for the relative motion q_a - q_b)
 
 Every unknown key is an error naming the key and the file.  Errors are :class:`CaseError`
 (a ``ValueError``) with a one-line message.
@@ -35,20 +37,24 @@ class CaseError(ValueError):
 
 TOP_KEYS = ("name", "model", "element", "excitation", "analysis")
 MODEL_KEYS = ("mass", "stiffness", "damping", "rayleigh", "modal_damping", "dof_names", "file")
-EXCITATION_KEYS = ("dofs", "amplitude")
+EXCITATION_KEYS = ("dofs", "amplitude", "base")
+BASE_KEYS = ("dofs", "amplitude")
 ANALYSIS_KEYS = ("harmonics", "time_samples", "frequency_hz", "outputs", "max_points", "transform")
 
 
 @dataclass(frozen=True)
 class Excitation:
-    """Cosine force at the first harmonic: ``force`` (n,) amplitudes in N."""
+    """Cosine force at the first harmonic, ``force`` (n,) in N, and optionally imposed
+    support motion ``base = (dofs (k,), amplitude (k,))`` in m (cosine, first harmonic)."""
 
     force: np.ndarray
+    base: tuple | None = None
 
 
 @dataclass(frozen=True)
 class Analysis:
-    """Analysis settings: harmonic list, samples per period, frequency range (Hz), outputs."""
+    """Analysis settings: harmonic list, samples per period, frequency range (Hz), and
+    ``outputs``: name -> gather row (n,) (a DOF, or ``q_a - q_b``)."""
 
     harmonics: np.ndarray
     time_samples: int
@@ -180,20 +186,54 @@ def _dof(d, model, where, path):
         raise CaseError(f"{path}: {exc}") from None
 
 
-def _excitation(t, model, path):
-    _check_keys(t, EXCITATION_KEYS, "[excitation]", path)
-    for k in EXCITATION_KEYS:
+def _dof_amplitudes(t, model, where, path):
+    for k in ("dofs", "amplitude"):
         if k not in t:
-            raise CaseError(f"{path}: [excitation] missing key {k!r}")
+            raise CaseError(f"{path}: {where} missing key {k!r}")
     dofs, amp = t["dofs"], t["amplitude"]
     if not isinstance(dofs, list) or not isinstance(amp, list) or len(dofs) != len(amp) or not dofs:
-        raise CaseError(f"{path}: [excitation] dofs and amplitude must be lists of the same length")
+        raise CaseError(f"{path}: {where} dofs and amplitude must be lists of the same length")
+    idx = [_dof(d, model, f"{where} dofs", path) for d in dofs]
+    if len(set(idx)) != len(idx):
+        raise CaseError(f"{path}: {where} dofs repeats a DOF")
+    return np.array(idx, dtype=int), np.array([_number(a, f"{where} amplitude", path) for a in amp])
+
+
+def _excitation(t, model, path):
+    _check_keys(t, EXCITATION_KEYS, "[excitation]", path)
     force = np.zeros(model.n_dof)
-    for d, a in zip(dofs, amp):
-        force[_dof(d, model, "[excitation] dofs", path)] += _number(a, "[excitation] amplitude", path)
-    if not np.any(force):
+    if "dofs" in t or "amplitude" in t or "base" not in t:
+        idx, amp = _dof_amplitudes(t, model, "[excitation]", path)
+        force[idx] = amp
+    base = None
+    if "base" in t:
+        _check_keys(t["base"], BASE_KEYS, "[excitation] base", path)
+        bd, ba = _dof_amplitudes(t["base"], model, "[excitation] base", path)
+        if bd.size == model.n_dof:
+            raise CaseError(f"{path}: [excitation] base: every DOF is a support: nothing is free")
+        if np.any(force[bd]):
+            raise CaseError(f"{path}: [excitation] a DOF cannot be both forced and a moving support")
+        base = (bd, ba)
+    if not np.any(force) and (base is None or not np.any(base[1])):
         raise CaseError(f"{path}: [excitation] amplitude is zero: nothing to respond to")
-    return Excitation(force)
+    return Excitation(force, base)
+
+
+def _output_row(name, v, model, path):
+    """Gather row (n,) of an output: a DOF (index or name) or [a, b] for q_a - q_b."""
+    where = f"[analysis] outputs.{name}"
+    g = np.zeros(model.n_dof)
+    if isinstance(v, list):
+        if len(v) != 2:
+            raise CaseError(f"{path}: {where} must be a DOF or [a, b] (q_a - q_b), got {v!r}")
+        a, b = (_dof(d, model, where, path) for d in v)
+        if a == b:
+            raise CaseError(f"{path}: {where}: [a, b] must name two different DOFs")
+        g[a], g[b] = 1.0, -1.0
+    else:
+        g[_dof(v, model, where, path)] = 1.0
+    g.setflags(write=False)
+    return g
 
 
 def _analysis(t, model, elements, path):
@@ -222,7 +262,7 @@ def _analysis(t, model, elements, path):
     outs = t["outputs"]
     if not isinstance(outs, dict) or not outs:
         raise CaseError(f"{path}: [analysis] outputs must be a table name = dof")
-    outputs = {str(k): _dof(v, model, f"[analysis] outputs.{k}", path) for k, v in outs.items()}
+    outputs = {str(k): _output_row(k, v, model, path) for k, v in outs.items()}
     mp = _number(t.get("max_points", 2000), "[analysis] max_points", path, positive=True, integer=True)
     tr = t.get("transform", "auto")
     if tr not in ("auto", "dft", "numpy", "fftw"):

@@ -9,7 +9,8 @@ the work of a periodic force ``F`` on the velocity over one period is (Parseval)
 
 At a converged point the excitation's work equals the viscous plus the friction dissipation,
 :math:`W[F_{ex}] = \frac{T}{2}\sum_r V_r^T C V_r + W[F_{nl}]` (stiffness and mass forces do
-no work over a period).
+no work over a period).  Supports with imposed motion (base excitation) add the work of
+the force that drives them, ``W[R_b]`` on their velocities, to the input.
 """
 from __future__ import annotations
 
@@ -43,6 +44,8 @@ def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
     basis = problem.basis
     V = w * (basis.D @ X)
     w_ex = work(basis, problem.Fex, V, w)
+    if problem.fixed.size:
+        w_ex += work(basis, problem.support_reactions(X, w), V[:, problem.fixed], w)
     w_visc = work(basis, V @ problem.model.C, V, w)
     w_nl = work(basis, problem.nonlinear_forces(X, w), V, w)
     return EnergyBalance(w_ex, w_visc, w_nl)

@@ -8,7 +8,13 @@ r"""Harmonic-balance residual and its exact Jacobian, composed from its parts.
 
 ``X`` has shape (n_coef, n) (harmonic-major, :mod:`hbm.fourier`); ``Z`` is applied block by
 block per harmonic (:func:`hbm.linear.harmonic_blocks`); ``F_ex`` is a cosine force at the
-first harmonic.  The continuation works on ``x = [X.ravel(), w]``.
+first harmonic.  The continuation works on ``x = [X[:, free].ravel(), w]``.
+
+Base (support) excitation: DOFs listed as supports have prescribed coefficients
+``X_b`` (a cosine motion at the first harmonic) and are not unknowns; their rows of the
+residual are dropped.  Their motion drives the free DOFs through the coupling terms of
+``Z`` (stiffness, damping and mass that connect to the support) and through any element
+attached to them, exactly as in the full equations.
 """
 from __future__ import annotations
 
@@ -32,9 +38,12 @@ class HarmonicBalance:
         Amplitude of the cosine excitation at the first harmonic, per DOF.
     transform : object
         AFT transform built on ``basis``.
+    base : tuple (dofs, amplitude), optional
+        Support DOFs (k,) and the amplitudes (k,) of their imposed motion ``A cos(w t)``.
     """
 
-    def __init__(self, model: LinearModel, elements, basis: FourierBasis, force, transform):
+    def __init__(self, model: LinearModel, elements, basis: FourierBasis, force, transform,
+                 base=None):
         if 1 not in basis.harmonics:
             raise ValueError("the harmonic list must contain harmonic 1 (the excitation's)")
         self.model = model
@@ -45,6 +54,17 @@ class HarmonicBalance:
         Fex = np.zeros((basis.n_coef, n))
         Fex[basis.row_of(1, "c")] = np.asarray(force, dtype=float)
         self.Fex = Fex
+        fixed = np.zeros(n, dtype=bool)
+        Xfix = np.zeros((basis.n_coef, n))
+        if base is not None:
+            bd, ba = base
+            fixed[np.asarray(bd, dtype=int)] = True
+            Xfix[basis.row_of(1, "c"), np.asarray(bd, dtype=int)] = np.asarray(ba, dtype=float)
+        self.fixed = np.flatnonzero(fixed)
+        self.free = np.flatnonzero(~fixed)
+        self.X_fixed = Xfix
+        self._all_free = self.fixed.size == 0
+        self._free_index = (np.arange(basis.n_coef)[:, None] * n + self.free[None, :]).ravel()
         # row slices of each harmonic's block in the flat unknown vector
         self._slices = []
         r = 0
@@ -64,7 +84,19 @@ class HarmonicBalance:
 
     @property
     def n_unknowns(self) -> int:
-        return self.basis.n_coef * self.n_dof
+        return self.basis.n_coef * self.free.size
+
+    def expand(self, x: np.ndarray) -> np.ndarray:
+        """Unknown vector (n_coef * n_free,) -> full coefficients (n_coef, n) with supports."""
+        if self._all_free:
+            return x.reshape(self.basis.n_coef, self.n_dof)
+        X = self.X_fixed.copy()
+        X[:, self.free] = x.reshape(self.basis.n_coef, self.free.size)
+        return X
+
+    def unknowns(self, X: np.ndarray) -> np.ndarray:
+        """Full coefficients (n_coef, n) -> unknown vector (n_coef * n_free,)."""
+        return X.reshape(-1).copy() if self._all_free else X[:, self.free].reshape(-1)
 
     def linear_part(self, X: np.ndarray, w: float):
         """``Z(w) X`` (n_coef, n), ``Z(w)`` dense (n_u, n_u) and ``Z'(w) X`` (n_coef, n).
@@ -101,7 +133,9 @@ class HarmonicBalance:
         Returns
         -------
         R : ndarray, shape (n_u,)
+            On the free DOFs (harmonic-major).
         dRdX : ndarray, shape (n_u, n_u)
+            With respect to the unknowns (free DOFs).
         dRdw : ndarray, shape (n_u,)
         """
         ZX, J, dZX = self.linear_part(X, w)
@@ -112,12 +146,21 @@ class HarmonicBalance:
             R[:, self.nl.dofs] += F
             dRdw[:, self.nl.dofs] += dFw
             J[np.ix_(self._nl_index, self._nl_index)] += dF
-        return R.reshape(-1), J, dRdw.reshape(-1)
+        if self._all_free:
+            return R.reshape(-1), J, dRdw.reshape(-1)
+        fi = self._free_index
+        return R.reshape(-1)[fi], J[np.ix_(fi, fi)], dRdw.reshape(-1)[fi]
+
+    def support_reactions(self, X: np.ndarray, w: float) -> np.ndarray:
+        """Force the structure needs from its supports to move them, (n_coef, n_fixed):
+        the support DOFs' rows of ``Z X + F_nl - F_ex``."""
+        ZX, _, _ = self.linear_part(X, w)
+        R = ZX - self.Fex + self.nonlinear_forces(X, w)
+        return R[:, self.fixed]
 
     def __call__(self, x: np.ndarray):
-        """Continuation form: ``x = [X.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]`` (n_u, n_u + 1)."""
-        X = x[:-1].reshape(self.basis.n_coef, self.n_dof)
-        R, J, dw = self.residual(X, float(x[-1]))
+        """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]`` (n_u, n_u + 1)."""
+        R, J, dw = self.residual(self.expand(x[:-1]), float(x[-1]))
         return R, np.hstack([J, dw[:, None]])
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
@@ -128,20 +171,26 @@ class HarmonicBalance:
         return F
 
     def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
-        """Solution of ``(Z(w) + K_extra) X = F_ex`` (n_coef, n): the start of Newton.
+        """Solution of ``(Z(w) + K_extra) X = F_ex`` (n_coef, n) with the supports' motion
+        imposed: the start of Newton.
 
         ``extra_stiffness`` (n, n) adds e.g. the stuck stiffness of the elements.
         """
         blocks, _ = harmonic_blocks(self.model, self.basis, w)
-        X = np.zeros_like(self.Fex)
-        f = self.Fex.reshape(-1)
-        x = X.reshape(-1)
+        X = self.X_fixed.copy()
         n = self.n_dof
+        fr = self.free
         for h, s, B in zip(self.basis.harmonics, self._slices, blocks):
             if extra_stiffness is not None:
                 B = B.copy()
                 for k in range(B.shape[0] // n):
                     B[k * n:(k + 1) * n, k * n:(k + 1) * n] += extra_stiffness
-            if np.any(f[s]):
-                x[s] = np.linalg.solve(B, f[s])
+            nr = B.shape[0] // n
+            rows = slice(s.start // n, s.start // n + nr)
+            Xr = X[rows]
+            f_full = (self.Fex[rows].reshape(-1) - B @ Xr.reshape(-1)).reshape(nr, n)
+            if not np.any(f_full[:, fr]):
+                continue
+            Bb = B.reshape(nr, n, nr, n)[:, fr][:, :, :, fr].reshape(nr * fr.size, nr * fr.size)
+            Xr[:, fr] = np.linalg.solve(Bb, f_full[:, fr].reshape(-1)).reshape(nr, fr.size)
         return X

@@ -104,18 +104,24 @@ def _stuck_stiffness(case: Case) -> np.ndarray:
 
 
 def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
-    """Per-DOF amplitude scale: geometric mean of the stuck and free linear peak responses."""
+    """Per-unknown scale: geometric mean of the stuck and free linear peak responses per DOF.
+
+    The linear responses include the supports' imposed motion (base excitation).
+    """
     ws = np.linspace(w_lo, w_hi, 41)
     Ks = _stuck_stiffness(case)
-    amp_free = np.zeros(case.n_dof)
-    amp_stuck = np.zeros(case.n_dof)
-    n = case.n_dof
-    M, C, K, f = case.model.M, case.model.C, case.model.K, case.excitation.force
+    fr, fx = problem.free, problem.fixed
+    amp_free = np.zeros(fr.size)
+    amp_stuck = np.zeros(fr.size)
+    M, C, K = case.model.M, case.model.C, case.model.K
+    f = case.excitation.force[fr]
+    yb = problem.X_fixed[problem.basis.row_of(1, "c"), fx]
     for w in ws:
         for Kx, amp in ((K, amp_free), (K + Ks, amp_stuck)):
             Zc = Kx - w * w * M + 1j * w * C
+            rhs = f - Zc[np.ix_(fr, fx)] @ yb
             try:
-                x = np.linalg.solve(Zc, f)
+                x = np.linalg.solve(Zc[np.ix_(fr, fr)], rhs)
             except np.linalg.LinAlgError:
                 continue
             np.maximum(amp, np.abs(x), out=amp)
@@ -125,30 +131,48 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
 
 
 def _first_point(problem, case, w0, scale, r_scale):
-    """Converged first point ``X`` (n_coef, n) at ``w0``, or raise RuntimeError with the reason."""
-    fun = lambda X: problem.residual(X.reshape(problem.Fex.shape), w0)[:2]
+    """Converged first point ``X`` (n_coef, n) at ``w0``, or raise RuntimeError with the reason.
+
+    Newton from the linear response with the elements stuck, then without them; failing
+    both, the Newton homotopy ``R(x) - (1 - lam) R(0)`` from ``lam = 0`` (solved by ``x = 0``)
+    to ``lam = 1``.
+    """
+    fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
     guesses = [problem.linear_solution(w0, _stuck_stiffness(case)), problem.linear_solution(w0)]
     last = None
     for g in guesses:
-        res = newton(fun, g.ravel(), scale=scale, r_scale=r_scale)
+        res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale)
         if res.converged:
-            return res.x.reshape(problem.Fex.shape), res.iterations
+            return problem.expand(res.x), res.iterations
         last = res
-    # ramp the excitation from a small fraction
-    Fex = problem.Fex
-    X = guesses[0] * 0.1
+    x = np.zeros(problem.n_unknowns)
+    R0 = fun(x)[0]
     its = 0
     for lam in (0.1, 0.2, 0.35, 0.5, 0.7, 0.85, 1.0):
         def fun_l(x, lam=lam):
             R, J = fun(x)
-            return R + (1.0 - lam) * Fex.ravel(), J
-        res = newton(fun_l, X.ravel(), scale=scale, r_scale=r_scale * lam, max_iter=60)
+            return R - (1.0 - lam) * R0, J
+        res = newton(fun_l, x, scale=scale, r_scale=r_scale, max_iter=60)
         its += res.iterations
         if not res.converged:
             raise RuntimeError(f"first point at {w0 / (2 * np.pi):.6g} Hz did not converge "
-                               f"(linear starts: {last.message}; ramp stopped at {lam:.0%} of the force: {res.message})")
-        X = res.x.reshape(Fex.shape)
-    return X, its
+                               f"(linear starts: {last.message}; ramp stopped at {lam:.0%} of the excitation: "
+                               f"{res.message})")
+        x = res.x
+    return problem.expand(x), its
+
+
+def _residual_scale(problem, w) -> float:
+    """Typical force of the problem: the norm of the residual at zero unknowns (the load)."""
+    R = problem.residual(problem.expand(np.zeros(problem.n_unknowns)), w)[0]
+    return float(max(np.linalg.norm(R), 1e-300))
+
+
+def build_problem(case: Case, basis: FourierBasis, transform: str) -> HarmonicBalance:
+    """The harmonic-balance residual of ``case`` on ``basis``."""
+    ex = case.excitation
+    return HarmonicBalance(case.model, case.elements, basis, ex.force, make_transform(basis, transform),
+                           base=ex.base)
 
 
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
@@ -178,12 +202,11 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     """
     h, N, lo, hi, tr = resolve_settings(case, harmonics, samples, fmin, fmax, transform)
     basis = FourierBasis(h, N)
-    problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force,
-                              make_transform(basis, tr))
+    problem = build_problem(case, basis, tr)
     w_lo, w_hi = 2 * np.pi * lo, 2 * np.pi * hi
     t0 = time.perf_counter()
     xscale = _unknown_scale(problem, case, w_lo, w_hi)
-    r_scale = float(np.linalg.norm(case.excitation.force))
+    r_scale = _residual_scale(problem, w_lo)
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
                 "transform": problem.nl.transform.name}
     shape = problem.Fex.shape
@@ -197,10 +220,10 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     else:
         scale = np.r_[xscale, w_hi - w_lo]
         opts = options or ArclengthOptions()
-        solver = Arclength(problem, np.r_[X0.ravel(), w_lo], scale, lam_bounds=(w_lo, w_hi),
+        solver = Arclength(problem, np.r_[problem.unknowns(X0), w_lo], scale, lam_bounds=(w_lo, w_hi),
                            direction=+1, options=opts)
         for pt in solver:
-            X = pt.x[:-1].reshape(shape)
+            X = problem.expand(pt.x[:-1])
             w = float(pt.x[-1])
             pts_X.append(X)
             pts_w.append(w)
@@ -219,8 +242,8 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
     outputs = {}
-    for name, dof in out_dofs.items():
-        xd = Xs[:, :, dof]
+    for name, g in out_dofs.items():
+        xd = Xs @ g
         if 1 in basis.harmonics and Xs.shape[0]:
             rc = basis.row_of(1, "c")
             h1 = np.hypot(xd[:, rc], xd[:, rc + 1])
@@ -248,15 +271,14 @@ def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform
     """
     h, N, _, _, tr = resolve_settings(case, harmonics, samples, None, None, transform)
     basis = FourierBasis(h, N)
-    problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force,
-                              make_transform(basis, tr))
+    problem = build_problem(case, basis, tr)
     w = 2 * np.pi * float(freq_hz)
     xscale = _unknown_scale(problem, case, w * 0.9, w * 1.1)
-    X, _ = _first_point(problem, case, w, xscale, float(np.linalg.norm(case.excitation.force)))
+    X, _ = _first_point(problem, case, w, xscale, _residual_scale(problem, w))
     return X, basis, problem
 
 
 def output_amplitudes(basis: FourierBasis, x: np.ndarray):
-    """``(h1, max)`` of one DOF's coefficients ``x`` (n_coef,)."""
+    """``(h1, max)`` of one output's coefficients ``x`` (n_coef,) (e.g. ``X @ g`` or ``X[:, dof]``)."""
     rc = basis.row_of(1, "c")
     return float(np.hypot(x[rc], x[rc + 1])), float(max_abs(basis, x[:, None])[0])

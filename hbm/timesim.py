@@ -616,6 +616,11 @@ class _State:
         return other
 
 
+def _check_supported(case: Case) -> None:
+    if case.excitation.base is not None:
+        raise CaseError(f"{case.path}: timesim does not support [excitation] base (support motion) yet")
+
+
 def _check_freq(freq_hz):
     try:
         f = float(freq_hz)
@@ -631,12 +636,13 @@ def _amplitudes(case: Case, hist: History, N: int):
     q = hist.q[-(N + 1):]
     th = 2.0 * np.pi * np.arange(1, N + 1) / N
     h1, mx = {}, {}
-    for name, dof in case.analysis.outputs.items():
-        x = q[1:, dof]
+    for name, g in case.analysis.outputs.items():
+        xo = q @ g
+        x = xo[1:]
         a = 2.0 / N * np.dot(x, np.cos(th))
         b = 2.0 / N * np.dot(x, np.sin(th))
         h1[name] = float(np.hypot(a, b))
-        mx[name] = float(np.abs(q[:, dof]).max())
+        mx[name] = float(np.abs(xo).max())
     return h1, mx
 
 
@@ -775,6 +781,7 @@ def timesim(case: Case, freq_hz: float, options: TimeSimOptions | None = None,
     opts = options or TimeSimOptions()
     opts.validate()
     f = _check_freq(freq_hz)
+    _check_supported(case)
     t0 = time.perf_counter()
     if periods is None:
         packed = pack_elements(case.elements, case.n_dof)

@@ -29,7 +29,7 @@ def write_summary_csv(case, res, path: Path) -> None:
 def write_history_csv(case, res, path: Path) -> None:
     hist = res.history
     outs = case.analysis.outputs
-    cols = [hist.t] + [hist.q[:, d] for d in outs.values()] + [hist.forces[:, i] for i in range(hist.forces.shape[1])]
+    cols = [hist.t] + [hist.q @ g for g in outs.values()] + [hist.forces[:, i] for i in range(hist.forces.shape[1])]
     data = np.column_stack(cols)
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -46,8 +46,8 @@ def write_plot(case, res, path: Path) -> None:
     n_f = hist.forces.shape[1]
     fig, axes = plt.subplots(1, 2 if n_f else 1, figsize=(11 if n_f else 7, 4.2), squeeze=False)
     ax = axes[0, 0]
-    for name, dof in case.analysis.outputs.items():
-        ax.plot(hist.t, hist.q[:, dof], lw=0.9, label=name)
+    for name, g in case.analysis.outputs.items():
+        ax.plot(hist.t, hist.q @ g, lw=0.9, label=name)
     if res.switch_off_at is not None:
         ax.axvline(res.switch_off_at, color="0.5", ls=":", lw=0.8, label="force off")
     ax.set_xlabel("time (s)")
