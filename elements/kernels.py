@@ -76,6 +76,37 @@ def _accumulate(M, X, out):
 
 
 @nb.njit(cache=True)
+def _propagate(A, B, ds, dzj, out):
+    """``out = A @ ds + B @ dzj`` skipping zero entries of the small matrices ``A``, ``B``."""
+    P = ds.shape[1]
+    for i in range(A.shape[0]):
+        first = True
+        for k in range(A.shape[1]):
+            m = A[i, k]
+            if m != 0.0:
+                if first:
+                    for c in range(P):
+                        out[i, c] = m * ds[k, c]
+                    first = False
+                else:
+                    for c in range(P):
+                        out[i, c] += m * ds[k, c]
+        for k in range(B.shape[1]):
+            m = B[i, k]
+            if m != 0.0:
+                if first:
+                    for c in range(P):
+                        out[i, c] = m * dzj[k, c]
+                    first = False
+                else:
+                    for c in range(P):
+                        out[i, c] += m * dzj[k, c]
+        if first:
+            for c in range(P):
+                out[i, c] = 0.0
+
+
+@nb.njit(cache=True)
 def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     """March a law over one sampled period with forward-mode derivative seeds.
 
@@ -124,11 +155,11 @@ def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
         passes += 1
         s_begin[:] = s
         for jj in range(1, N + 1):
-            j = (start + jj) % N
+            j = start + jj
+            if j >= N:
+                j -= N
             law_step(kind, p, s, z[j], s_new, A, B)
-            ds_new[:, :] = 0.0
-            _accumulate(A, ds, ds_new)
-            _accumulate(B, dz[j], ds_new)
+            _propagate(A, B, ds, dz[j], ds_new)
             s, s_new = s_new, s
             ds, ds_new = ds_new, ds
             for a in range(n_local):

@@ -128,9 +128,10 @@ class NonlinearForces:
             dFe = self.transform.analyse(df.reshape(N, nl * Pcols)).reshape(nc, nl, Pcols)
             F += Fe @ G
             dFdw += dFe[:, :, -1] @ G
-            # (G^T dU G) on the DOF axes, batched over the coefficient pairs
-            dU = dFe[:, :, :-1].reshape(nc, nl, nc, nl).transpose(0, 2, 1, 3)
-            J4 += (G.T @ dU @ G).transpose(0, 2, 1, 3)
+            # (G^T dU G) on the DOF axes: two plain matrix products, no transposes
+            dU = dFe[:, :, :-1]                                   # (nc, nl, nc * nl)
+            T = np.matmul(G.T, dU)                                # (nc, nn, nc * nl)
+            J4 += (T.reshape(nc * nn * nc, nl) @ G).reshape(nc, nn, nc, nn)
         return F, J4.reshape(nc * nn, nc * nn), dFdw
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:

@@ -65,6 +65,7 @@ class HarmonicBalance:
         self.X_fixed = Xfix
         self._all_free = self.fixed.size == 0
         self._free_index = (np.arange(basis.n_coef)[:, None] * n + self.free[None, :]).ravel()
+        self._nl_all = self.nl.n_nl == n
         # row slices of each harmonic's block in the flat unknown vector
         self._slices = []
         r = 0
@@ -98,8 +99,10 @@ class HarmonicBalance:
         """Full coefficients (n_coef, n) -> unknown vector (n_coef * n_free,)."""
         return X.reshape(-1).copy() if self._all_free else X[:, self.free].reshape(-1)
 
-    def linear_part(self, X: np.ndarray, w: float):
+    def linear_part(self, X: np.ndarray, w: float, out=None):
         """``Z(w) X`` (n_coef, n), ``Z(w)`` dense (n_u, n_u) and ``Z'(w) X`` (n_coef, n).
+
+        ``out``, if given, is a zeroed (n_u, n_u) array (or view) that receives ``Z``.
 
         Per coefficient row ``r`` of harmonic ``h_r``: ``(Z X)_r = K X_r + w C (D X)_r
         - w^2 h_r^2 M X_r`` (``D`` the derivative operator), evaluated for all rows at
@@ -111,7 +114,7 @@ class HarmonicBalance:
         ZX = X @ K + w * (DX @ C) - (w * w) * (h2X @ M)
         dZX = DX @ C - (2.0 * w) * (h2X @ M)
         nc, n = X.shape
-        Z = np.zeros((nc * n, nc * n))
+        Z = np.zeros((nc * n, nc * n)) if out is None else out
         Z4 = Z.reshape(nc, n, nc, n)
         r = self._rows
         Z4[r, :, r, :] = K[None] - (w * w) * self._h2[:, None, None] * M[None]
@@ -138,18 +141,30 @@ class HarmonicBalance:
             With respect to the unknowns (free DOFs).
         dRdw : ndarray, shape (n_u,)
         """
-        ZX, J, dZX = self.linear_part(X, w)
-        R = ZX - self.Fex
-        dRdw = dZX
-        if self.nl.n_nl:
-            F, dF, dFw = self.nl.evaluate(np.ascontiguousarray(X[:, self.nl.dofs]), w)
-            R[:, self.nl.dofs] += F
-            dRdw[:, self.nl.dofs] += dFw
-            J[np.ix_(self._nl_index, self._nl_index)] += dF
+        R, J, dRdw = self._full_residual(X, w)
         if self._all_free:
             return R.reshape(-1), J, dRdw.reshape(-1)
         fi = self._free_index
         return R.reshape(-1)[fi], J[np.ix_(fi, fi)], dRdw.reshape(-1)[fi]
+
+    def _full_residual(self, X, w, out=None):
+        """Residual (n_coef, n), Jacobian (n_c n, n_c n) and dR/dw (n_coef, n) on all DOFs."""
+        ZX, J, dZX = self.linear_part(X, w, out)
+        R = ZX - self.Fex
+        dRdw = dZX
+        if self.nl.n_nl:
+            dofs = self.nl.dofs
+            if self._nl_all:
+                F, dF, dFw = self.nl.evaluate(X, w)
+                R += F
+                dRdw += dFw
+                J += dF
+            else:
+                F, dF, dFw = self.nl.evaluate(np.ascontiguousarray(X[:, dofs]), w)
+                R[:, dofs] += F
+                dRdw[:, dofs] += dFw
+                J[np.ix_(self._nl_index, self._nl_index)] += dF
+        return R, J, dRdw
 
     def support_reactions(self, X: np.ndarray, w: float) -> np.ndarray:
         """Force the structure needs from its supports to move them, (n_coef, n_fixed):
@@ -160,7 +175,15 @@ class HarmonicBalance:
 
     def __call__(self, x: np.ndarray):
         """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]`` (n_u, n_u + 1)."""
-        R, J, dw = self.residual(self.expand(x[:-1]), float(x[-1]))
+        X = self.expand(x[:-1])
+        w = float(x[-1])
+        if self._all_free:
+            nu = X.size
+            Jw = np.zeros((nu, nu + 1))
+            R, _, dw = self._full_residual(X, w, Jw[:, :nu])
+            Jw[:, nu] = dw.reshape(-1)
+            return R.reshape(-1), Jw
+        R, J, dw = self.residual(X, w)
         return R, np.hstack([J, dw[:, None]])
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
