@@ -1,0 +1,357 @@
+"""Run time against error: HBM against the time-domain reference, transforms, numba against NumPy.
+
+Run by hand or with ``make bench`` (never part of the tests)::
+
+    python benchmarks/time_vs_error.py [--quick]
+
+Sections (every figure is measured in this run; speeds are reported as ratios):
+
+1. Accuracy and cost of HBM across H and N for three cases (SDOF Jenkins, a 3-DOF blade
+   couple with two Jenkins contacts, an inclined friction3d contact), against a converged
+   HBM reference (H = 31, N = 1024) whose peak is checked against ``hbm timesim``:
+   peak-amplitude error, whole-FRF error (max relative error of the first harmonic on a
+   common frequency grid), solve time; and the time the time-domain reference needs for
+   the same FRF at the same peak error (steps per period found by bisection on a ladder),
+   as the ratio t_time_domain / t_hbm.
+2. The three AFT transforms (DFT matrix, NumPy FFT, pyFFTW) across H: time of one
+   synthesis + analysis of an element's seeded signals, and which wins.
+3. The numba march against a plain NumPy/Python implementation of the same Jenkins law.
+4. The issue's target case (3-DOF, two Jenkins, H = 7, N = 256) and where one Newton
+   iteration's time goes (residual + Jacobian, its transforms, its linear solve).
+
+Writes ``benchmarks/results/time_vs_error.csv`` and ``time_vs_error.png``.
+CPU time (``time.process_time``), best of repeats, so a busy machine perturbs it less.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import hbm  # noqa: E402
+from hbm.case import case_from_dict  # noqa: E402
+from hbm.fourier import FourierBasis  # noqa: E402
+from hbm.response import build_problem, solve_at, output_amplitudes  # noqa: E402
+from hbm.transforms import TRANSFORMS  # noqa: E402
+
+RESULTS = ROOT / "benchmarks" / "results"
+
+
+def cpu(fun, repeat=3):
+    """Best CPU time of ``repeat`` calls of ``fun`` and its last result."""
+    best, out = np.inf, None
+    for _ in range(repeat):
+        t = time.process_time()
+        out = fun()
+        best = min(best, time.process_time() - t)
+    return best, out
+
+
+# ----------------------------------------------------------------------------- cases
+def sdof_case(H=7, N=128):
+    return case_from_dict({
+        "name": "SDOF Jenkins",
+        "model": {"mass": [[1.0]], "stiffness": [[1.0]], "damping": [[0.02]]},
+        "element": [{"type": "jenkins", "dofs": [0], "kt": 2.0, "slip_force": 0.3}],
+        "excitation": {"dofs": [0], "amplitude": [1.0]},
+        "analysis": {"harmonics": H, "time_samples": N, "frequency_hz": [0.1, 0.3], "outputs": {"x": 0}},
+    })
+
+
+def couple_case(H=7, N=128):
+    # seed 001's blade couple: two blades (0, 1) and the friction element (2) between them
+    m, k, b, m3, k3 = 0.182, 105000.0, 0.1, 0.01, 1000.0
+    return case_from_dict({
+        "name": "3-DOF blade couple",
+        "model": {"mass": [[m, 0, 0], [0, m, 0], [0, 0, m3]],
+                  "stiffness": [[k, 0, 0], [0, k, 0], [0, 0, k3]],
+                  "damping": [[b, 0, 0], [0, b, 0], [0, 0, 0.0]]},
+        "element": [{"type": "jenkins", "dofs": [0, 2], "kt": 30000.0, "slip_force": 0.5},
+                    {"type": "jenkins", "dofs": [1, 2], "kt": 30000.0, "slip_force": 0.5}],
+        "excitation": {"dofs": [0], "amplitude": [1.0]},
+        "analysis": {"harmonics": H, "time_samples": N, "frequency_hz": [100.0, 135.0],
+                     "outputs": {"a1": 0}},
+    })
+
+
+def inclined_case(H=7, N=128):
+    # a mass on x (tangential) and y (normal) springs against a friction3d contact to ground
+    return case_from_dict({
+        "name": "friction3d contact",
+        "model": {"mass": [[1.0, 0], [0, 1.0]], "stiffness": [[1.0, 0.3], [0.3, 2.0]],
+                  "damping": [[0.01, 0], [0, 0.01]]},
+        "element": [{"type": "friction3d", "dofs": {"t1": [0], "n": [1]}, "kt": 1.5, "kn": 3.0,
+                     "mu": 0.3, "normal_preload": 1.0}],
+        "excitation": {"dofs": [0, 1], "amplitude": [0.5, 0.2]},
+        "analysis": {"harmonics": H, "time_samples": N, "frequency_hz": [0.08, 0.3], "outputs": {"x": 0}},
+    })
+
+
+CASES = {"sdof_jenkins": sdof_case, "blade_couple": couple_case, "friction3d": inclined_case}
+
+
+# ----------------------------------------------------------------------------- section 1
+def refined_peak(res, name):
+    """Peak of h1 along the path, refined by a parabola through the three highest points."""
+    a = res.outputs[name].h1
+    f = res.freq_hz
+    i = int(np.argmax(a))
+    if 0 < i < a.size - 1 and f[i - 1] < f[i] < f[i + 1]:
+        c = np.polyfit(f[i - 1:i + 2], a[i - 1:i + 2], 2)
+        if c[0] < 0:
+            fp = -c[1] / (2 * c[0])
+            return float(np.polyval(c, fp)), float(fp)
+    return float(a[i]), float(f[i])
+
+
+def curve_error(res, ref, name, grid):
+    """Max relative error of h1 on ``grid`` (paths monotone in frequency only)."""
+    def interp(r):
+        f, a = r.freq_hz, r.outputs[name].h1
+        if np.any(np.diff(f) <= 0):
+            return None
+        return np.interp(grid, f, a)
+    a, b = interp(res), interp(ref)
+    if a is None or b is None:
+        return np.nan
+    return float(np.max(np.abs(a - b) / np.abs(b)))
+
+
+def time_domain_cost(case, f_peak, a_ref, name, ladder):
+    """Per-frequency timesim cost and peak error at each steps-per-period of the ladder."""
+    from hbm.timesim import TimeSimOptions, steady_state
+    g = case.analysis.outputs[name]
+    out = []
+    for steps in ladder:
+        opts = TimeSimOptions(steps=steps, tol=1e-9, max_periods=20000)
+        t, run = cpu(lambda: steady_state(case, f_peak, opts), repeat=1)
+        err = abs(run.h1[name] - a_ref) / a_ref
+        out.append((steps, err, t))
+    return out
+
+
+def td_time_at_error(td, err):
+    """CPU time per frequency the time domain needs for ``err`` (log-log interpolation)."""
+    steps, errs, times = (np.array(v, dtype=float) for v in zip(*td))
+    ok = errs <= err
+    if ok.any():
+        j = int(np.argmax(ok))
+        if j == 0:
+            return times[0]
+        # interpolate between ladder rungs j-1 (too coarse) and j in log error
+        e0, e1 = np.log(errs[j - 1]), np.log(errs[j])
+        s = (np.log(err) - e0) / (e1 - e0) if e1 != e0 else 1.0
+        return float(np.exp(np.log(times[j - 1]) + s * (np.log(times[j]) - np.log(times[j - 1]))))
+    # beyond the finest rung: extrapolate with second-order convergence (error ~ steps^-2)
+    return float(times[-1] * (errs[-1] / err) ** 0.5)
+
+
+def section_accuracy(quick):
+    rows = []
+    Hs = (1, 3, 5, 7, 11, 15) if quick else (1, 3, 5, 7, 11, 15, 21, 25)
+    ladder = (64, 128, 256, 512) if quick else (64, 128, 256, 512, 1024, 2048)
+    print("\n== 1. HBM accuracy and cost against the converged reference, and the time domain at equal error")
+    for cname, make in CASES.items():
+        ref_case = make(31, 1024)
+        name = list(ref_case.analysis.outputs)[0]
+        ref = hbm.frf(ref_case)
+        a_ref, f_peak = refined_peak(ref, name)
+        # the reference's peak against the time domain (independent check)
+        Xp, bp, _ = solve_at(ref_case, f_peak)
+        a_pt = output_amplitudes(bp, Xp @ ref_case.analysis.outputs[name])[0]
+        td = time_domain_cost(make(7, 128), f_peak, a_pt, name, ladder)
+        print(f"\n{ref_case.name}: reference peak {a_ref:.6g} at {f_peak:.6g} Hz "
+              f"(H=31, N=1024, {ref.freq_hz.size} points); time domain at the peak: "
+              + ", ".join(f"{s} steps: err {e:.1e} in {t:.2f} s" for s, e, t in td))
+        lo, hi = ref_case.analysis.freq_hz
+        grid = np.linspace(lo, hi, 400)
+        print(f"  {'H':>3} {'N':>5} {'points':>6} {'peak err':>9} {'FRF err':>9} {'HBM s':>8} "
+              f"{'TD s (same FRF)':>15} {'TD/HBM':>8}")
+        for H in Hs:
+            for N in sorted({max(64, 8 * H), max(256, 32 * H)}):
+                c = make(H, N)
+                hbm.frf(c)  # compile / warm
+                t, res = cpu(lambda: hbm.frf(c), repeat=2)
+                if not res.ok:
+                    print(f"  {H:3d} {N:5d}  FAILED: {res.message}")
+                    continue
+                a, _ = refined_peak(res, name)
+                e_peak = abs(a - a_ref) / a_ref
+                e_frf = curve_error(res, ref, name, grid)
+                t_td = td_time_at_error(td, max(e_peak, 1e-9)) * res.freq_hz.size
+                ratio = t_td / t
+                rows.append(dict(case=cname, H=H, N=N, points=res.freq_hz.size, peak_error=e_peak,
+                                 frf_error=e_frf, hbm_seconds=t, td_seconds_same_frf=t_td,
+                                 td_over_hbm=ratio))
+                print(f"  {H:3d} {N:5d} {res.freq_hz.size:6d} {e_peak:9.2e} {e_frf:9.2e} {t:8.3f} "
+                      f"{t_td:15.1f} {ratio:8.0f}")
+    return rows
+
+
+# ----------------------------------------------------------------------------- section 2
+def section_transforms(quick):
+    print("\n== 2. AFT transforms: synthesis + analysis of one element's signals (n_local=1, seeds included)")
+    print(f"  {'H':>3} {'N':>5} " + " ".join(f"{k:>10}" for k in TRANSFORMS) + "   fastest")
+    out = []
+    for H in ((1, 3, 7, 15, 25) if quick else (1, 3, 7, 15, 25, 51, 101)):
+        N = max(64, 1 << int(np.ceil(np.log2(8 * H))))
+        b = FourierBasis(np.arange(0, H + 1), N)
+        X = np.random.default_rng(0).standard_normal((b.n_coef, 1))
+        m = b.n_coef + 1
+        x = np.random.default_rng(1).standard_normal((N, m))
+        times = {}
+        for k, T in TRANSFORMS.items():
+            tr = T(b)
+            tr.synthesize(X)
+            tr.analyse(x)
+            n_rep = 2000 if H < 30 else 300
+            t, _ = cpu(lambda: [tr.analyse(x) for _ in range(n_rep)] and [tr.synthesize(X) for _ in range(n_rep)])
+            times[k] = t / n_rep * 1e6
+        best = min(times, key=times.get)
+        out.append((H, N, times, best))
+        print(f"  {H:3d} {N:5d} " + " ".join(f"{times[k]:9.1f}u" for k in TRANSFORMS) + f"   {best}")
+    return out
+
+
+# ----------------------------------------------------------------------------- section 3
+def plain_jenkins_march(u, dz, kt, fs, start):
+    """The Jenkins law and its seeds in plain NumPy/Python (one loop over samples)."""
+    N, P = u.shape[0], dz.shape[2]
+    f = np.empty(N)
+    df = np.empty((N, P))
+    ft = float(np.clip(kt * u[start, 0], -fs, fs))
+    dfp = (kt if abs(kt * u[start, 0]) <= fs else 0.0) * dz[start, 0]
+    up, dup = u[start, 0], dz[start, 0]
+    for jj in range(1, N + 1):
+        j = (start + jj) % N
+        trial = ft + kt * (u[j, 0] - up)
+        if abs(trial) <= fs:
+            ft, dfp = trial, dfp + kt * (dz[j, 0] - dup)
+        else:
+            ft, dfp = np.sign(trial) * fs, np.zeros(P)
+        up, dup = u[j, 0], dz[j, 0]
+        f[j], df[j] = ft, dfp
+    return f, df
+
+
+def section_numba(quick):
+    from elements import Jenkins
+    from hbm.aft import _seeds
+    print("\n== 3. numba march against plain NumPy/Python (Jenkins, seeds included)")
+    print(f"  {'H':>3} {'N':>5} {'numba us':>9} {'numpy us':>9} {'speed-up':>9}")
+    out = []
+    for H in ((3, 7, 15) if quick else (3, 7, 15, 25)):
+        N = max(64, 1 << int(np.ceil(np.log2(16 * H))))
+        b = FourierBasis(np.arange(1, H + 1), N)
+        el = Jenkins(np.array([[1.0]]), 1.0, 0.3)
+        S = _seeds(b, 1, False)
+        X = np.zeros((b.n_coef, 1))
+        X[0] = 1.0
+        X[2] = 0.2
+        u = np.ascontiguousarray(b.E @ X)
+        el.march(u, S)
+        st = el.start_index(u)
+        f1, d1 = el.march(u, S)
+        f2, d2 = plain_jenkins_march(u, S, 1.0, 0.3, st)
+        assert np.allclose(f1[:, 0], f2) and np.allclose(d1[:, 0], d2)
+        tn, _ = cpu(lambda: [el.march(u, S) for _ in range(500)])
+        tp, _ = cpu(lambda: [plain_jenkins_march(u, S, 1.0, 0.3, st) for _ in range(20)])
+        tn, tp = tn / 500 * 1e6, tp / 20 * 1e6
+        out.append((H, N, tn, tp))
+        print(f"  {H:3d} {N:5d} {tn:9.1f} {tp:9.1f} {tp / tn:8.0f}x")
+    return out
+
+
+# ----------------------------------------------------------------------------- section 4
+def section_target():
+    print("\n== 4. Target case: 3-DOF, two Jenkins, H = 7, N = 256")
+    c = case_from_dict({
+        "name": "3-DOF two Jenkins",
+        "model": {"mass": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+                  "stiffness": [[2e4, -1e4, 0], [-1e4, 2e4, -1e4], [0, -1e4, 2e4]], "modal_damping": 0.005},
+        "element": [{"type": "jenkins", "dofs": [0, 1], "kt": 1e4, "slip_force": 1.0},
+                    {"type": "jenkins", "dofs": [2], "kt": 5e3, "slip_force": 2.0}],
+        "excitation": {"dofs": [0], "amplitude": [3.0]},
+        "analysis": {"harmonics": 7, "time_samples": 256, "frequency_hz": [5.0, 40.0],
+                     "outputs": {"a": 0, "c": 2}},
+    })
+    hbm.frf(c)
+    t, res = cpu(lambda: hbm.frf(c), repeat=3)
+    print(f"  FRF: {res.freq_hz.size} points, {res.iterations.sum()} Newton iterations, "
+          f"{res.n_rejected} rejected steps, {t:.3f} s CPU ({t / res.freq_hz.size * 1e3:.2f} ms/point)")
+    b = FourierBasis(np.arange(1, 8), 256)
+    pb = build_problem(c, b, "auto")
+    X = res.X[res.X.shape[0] // 2]
+    x = np.r_[pb.unknowns(X), 2 * np.pi * res.freq_hz[res.X.shape[0] // 2]]
+    n = 2000
+    t_call, (R, J) = cpu(lambda: [pb(x) for _ in range(n)][-1])
+    t_call /= n
+    tr = pb.nl.transform
+    Xnl = X[:, pb.nl.dofs]
+    sig = [(Xnl @ G.T, np.zeros((256, G.shape[0] * (b.n_coef + 1)))) for G in pb.nl._G]
+
+    def transforms():
+        for U, d in sig:
+            tr.synthesize(U)
+            tr.analyse(d[:, :G.shape[0]])
+            tr.analyse(d)
+    t_tr, _ = cpu(lambda: [transforms() for _ in range(n)])
+    t_tr /= n
+    A = np.hstack([J[:, :-1], np.zeros((J.shape[0], 0))])
+    Ab = np.vstack([J, np.ones((1, J.shape[1]))])
+    t_lin, _ = cpu(lambda: [np.linalg.solve(Ab, np.ones(Ab.shape[0])) for _ in range(n)])
+    t_lin /= n
+    print(f"  one Newton iteration (residual + exact Jacobian): {t_call * 1e6:.0f} us; its transforms "
+          f"{t_tr * 1e6:.0f} us, its bordered linear solve {t_lin * 1e6:.0f} us: "
+          f"ratio {t_call / (t_tr + t_lin):.1f}x (transforms + solve)")
+    return dict(points=res.freq_hz.size, seconds=t, iteration_us=t_call * 1e6,
+                transforms_us=t_tr * 1e6, solve_us=t_lin * 1e6)
+
+
+def write_results(rows, path_csv, path_png):
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    with open(path_csv, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for cname in CASES:
+        r = [x for x in rows if x["case"] == cname]
+        if not r:
+            continue
+        line, = ax.loglog([x["hbm_seconds"] for x in r], [x["peak_error"] for x in r], "o-", label=f"{cname} HBM")
+        ax.loglog([x["td_seconds_same_frf"] for x in r], [x["peak_error"] for x in r], "s--",
+                  color=line.get_color(), alpha=0.6, label=f"{cname} time domain (same FRF)")
+    ax.set_xlabel("CPU time for the whole FRF (s)")
+    ax.set_ylabel("relative peak error")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path_png, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="fewer settings")
+    args = ap.parse_args(argv)
+    rows = section_accuracy(args.quick)
+    section_transforms(args.quick)
+    section_numba(args.quick)
+    section_target()
+    write_results(rows, RESULTS / "time_vs_error.csv", RESULTS / "time_vs_error.png")
+    print(f"\nwrote {RESULTS / 'time_vs_error.csv'} and {RESULTS / 'time_vs_error.png'}")
+
+
+if __name__ == "__main__":
+    main()
