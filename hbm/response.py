@@ -4,7 +4,8 @@ The FRF is the branch of solutions of :math:`R(X, w) = 0` (:mod:`hbm.residual`) 
 ``fmin`` to ``fmax`` by :mod:`continuation` on ``x = [X.ravel(), w]`` with per-unknown
 scaling.  The first point is solved by Newton from the linear response with the elements
 stuck; failing that, from the response without elements; failing that, by ramping the
-excitation.  Every converged point is checked by the energy balance (:mod:`hbm.energy`).
+excitation.  Every converged point is checked by the energy balance (:mod:`hbm.energy`)
+and, unless switched off, by Hill's method (:mod:`hbm.stability`).
 Outputs per point: first-harmonic amplitude ``h1 = sqrt(Xc1^2 + Xs1^2)`` and ``max`` of
 ``|x(t)|`` over a period on a fine grid.
 """
@@ -22,6 +23,7 @@ from .energy import energy_balance
 from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
 from .newton import newton
 from .residual import HarmonicBalance
+from .stability import StabilityOptions, point_stability
 from .transforms import make_transform
 
 
@@ -44,7 +46,8 @@ class FRFResult:
     outputs : dict of str -> OutputSeries
     X : ndarray, shape (n_points, n_coef, n)
         Harmonic coefficients of every point.
-    stable : ndarray of bool or None
+    stable : ndarray of bool, shape (n_points,), or None
+        Hill stability of every point (``None`` when not computed).
     folds_hz : list of float
     energy_error : ndarray, shape (n_points,)
         Relative energy-balance error per point.
@@ -152,7 +155,8 @@ def _first_point(problem, case, w0, scale, r_scale):
 
 
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
-        progress=None, options: ArclengthOptions | None = None) -> FRFResult:
+        progress=None, options: ArclengthOptions | None = None, stability: bool = True,
+        stability_options: StabilityOptions | None = None) -> FRFResult:
     """Trace the FRF of ``case``.
 
     Parameters
@@ -169,6 +173,10 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     progress : callable, optional
         Called as ``progress(n_points, freq_hz)`` after every converged point.
     options : ArclengthOptions, optional
+    stability : bool
+        Decide the stability of every point by Hill's method (``FRFResult.stable``);
+        ``False`` leaves ``stable`` as ``None``.
+    stability_options : StabilityOptions, optional
 
     Returns
     -------
@@ -185,7 +193,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     xscale = _unknown_scale(problem, case, w_lo, w_hi)
     r_scale = float(np.linalg.norm(case.excitation.force))
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
-                "transform": problem.nl.transform.name}
+                "transform": problem.nl.transform.name, "stability": bool(stability)}
     shape = problem.Fex.shape
     out_dofs = case.analysis.outputs
     pts_X, pts_w, its, eerr = [], [], [], []
@@ -216,6 +224,10 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             message = f"stopped after max_points={case.analysis.max_points} points at {pts_w[-1] / (2 * np.pi):.6g} Hz"
         folds = [f / (2 * np.pi) for f in solver.folds]
         n_rej = solver.n_rejected
+    stable = None
+    if stability:
+        stable = np.array([point_stability(problem, X, w, stability_options).stable
+                           for X, w in zip(pts_X, pts_w)], dtype=bool)
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
     outputs = {}
@@ -228,7 +240,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             h1 = np.zeros(Xs.shape[0])
         mx = max_abs(basis, xd.T)
         outputs[name] = OutputSeries(h1, mx)
-    return FRFResult(np.array(pts_w) / (2 * np.pi), outputs, Xs, basis, None, folds,
+    return FRFResult(np.array(pts_w) / (2 * np.pi), outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings)
 
 
