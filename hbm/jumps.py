@@ -11,8 +11,11 @@ the jump frequency is :math:`f_{hi}`, refined to the continuation's fold frequen
 fold lies beyond it by at most twice the adjacent frequency step (for a quadratic turning
 point between the last stable point and the next point it lies within one step); it lands on
 another piece that goes on upwards, :math:`f_{lo} \le f_{jump} < f_{hi}'`, at the amplitude
-:math:`a'(f_{jump})` interpolated linearly (the nearest in amplitude when several qualify),
-and the sweep goes on from there.  A downward sweep mirrors this.  A jump with no stable
+:math:`a'(f_{jump})` (the nearest in amplitude when several qualify), and the sweep goes on
+from there.  The landing amplitude is interpolated linearly between the two path points
+that bracket :math:`f_{jump}` unless a ``refine`` callable solves it there exactly (the
+continuation's steps are long on flat branches, where linear interpolation is poor).
+The amplitude before the jump is that of the last stable point.  A downward sweep mirrors this.  A jump with no stable
 landing piece (e.g. a loss of stability without a fold) ends the sweep with
 ``amplitude_after = None``.
 """
@@ -57,13 +60,27 @@ def stable_pieces(freq: np.ndarray, stable: np.ndarray) -> list:
     return pieces
 
 
+def _bracket(freq, a, b, f):
+    """Consecutive path indices ``(i, i+1)`` in ``[a, b]`` whose frequencies bracket ``f``."""
+    if a == b:
+        return a, a
+    for i in range(a, b):
+        lo, hi = sorted((freq[i], freq[i + 1]))
+        if lo <= f <= hi:
+            return i, i + 1
+    i = a if abs(freq[a] - f) <= abs(freq[b] - f) else b - 1
+    return i, i + 1
+
+
 def _amp_at(freq, amp, a, b, f):
-    fr, am = freq[a:b + 1], amp[a:b + 1]
-    order = np.argsort(fr, kind="stable")
-    return float(np.interp(f, fr[order], am[order]))
+    i, j = _bracket(freq, a, b, f)
+    if freq[j] == freq[i]:
+        return float(amp[i])
+    t = min(max((f - freq[i]) / (freq[j] - freq[i]), 0.0), 1.0)
+    return float(amp[i] + t * (amp[j] - amp[i]))
 
 
-def _refine(freq, i_end, f_end, folds, direction, tol):
+def _jump_frequency(freq, i_end, f_end, folds, direction, tol):
     """The nearest fold beyond ``f_end`` within twice the adjacent steps, else ``f_end``.
 
     For a quadratic turning point between the end point and the next point, the fold lies
@@ -79,7 +96,7 @@ def _refine(freq, i_end, f_end, folds, direction, tol):
     return f_end if best is None else best
 
 
-def _sweep(freq, amp, stable, folds, direction, tol):
+def _sweep(freq, amp, stable, folds, direction, tol, refine):
     pieces = stable_pieces(freq, stable)
     if not pieces:
         return []
@@ -98,7 +115,7 @@ def _sweep(freq, amp, stable, folds, direction, tol):
         if abs(f_end - (hi_all if direction > 0 else lo_all)) <= tol:
             break
         i_end = a + int(np.argmax(freq[a:b + 1] * direction))
-        f_jump = _refine(freq, i_end, f_end, folds, direction, tol)
+        f_jump = _jump_frequency(freq, i_end, f_end, folds, direction, tol)
         before = float(amp[i_end])
         cand = []
         for m, ((ca, cb), (c_lo, c_hi)) in enumerate(zip(pieces, ends)):
@@ -111,12 +128,15 @@ def _sweep(freq, amp, stable, folds, direction, tol):
             break
         _, m = min(cand)
         after = _amp_at(freq, amp, *pieces[m], f_jump)
+        if refine is not None:
+            exact = refine(*_bracket(freq, *pieces[m], f_jump), f_jump)
+            after = after if exact is None else float(exact)
         jumps.append({"from_hz": f_jump, "amplitude_before": before, "amplitude_after": after})
         k = m
     return jumps
 
 
-def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9) -> dict:
+def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9, refine=None) -> dict:
     """Jumps of slow upward and downward sweeps (module doc).
 
     Parameters
@@ -130,6 +150,9 @@ def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9
         Fold frequencies located by the continuation (refine the jump frequencies).
     rel_tol : float
         Frequencies closer than ``rel_tol * (max - min)`` count as equal.
+    refine : callable, optional
+        ``refine(i0, i1, f_hz) -> amplitude or None``: the amplitude at ``f_hz`` on the path
+        between points ``i0`` and ``i1`` solved exactly (``None``: keep the interpolation).
 
     Returns
     -------
@@ -147,4 +170,4 @@ def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9
         return {"up": [], "down": []}
     tol = rel_tol * max(float(f.max() - f.min()), 1e-300)
     folds = [float(x) for x in folds_hz]
-    return {"up": _sweep(f, amp, s, folds, +1, tol), "down": _sweep(f, amp, s, folds, -1, tol)}
+    return {"up": _sweep(f, amp, s, folds, +1, tol, refine), "down": _sweep(f, amp, s, folds, -1, tol, refine)}

@@ -45,6 +45,15 @@ def write_csv(res, path: Path) -> None:
             w.writerow(row)
 
 
+def _jumps(res):
+    """The result's predicted jumps, or computed from the path (interpolated landings)."""
+    if res.stable is None:
+        return None
+    if getattr(res, "jumps", None) is not None:
+        return res.jumps
+    return {n: predict_jumps(res.freq_hz, o.h1, res.stable, res.folds_hz) for n, o in res.outputs.items()}
+
+
 def summary_dict(case, res, extra=None) -> dict:
     d = {
         "case": case.name,
@@ -61,8 +70,7 @@ def summary_dict(case, res, extra=None) -> dict:
         "folds": [float(f) for f in res.folds_hz],
         "stability_computed": res.stable is not None,
         "n_unstable": None if res.stable is None else int(np.count_nonzero(~res.stable)),
-        "jumps": None if res.stable is None else {
-            n: predict_jumps(res.freq_hz, o.h1, res.stable, res.folds_hz) for n, o in res.outputs.items()},
+        "jumps": _jumps(res),
         "max_energy_error": float(res.energy_error.max()) if res.energy_error.size else None,
         "elements": [{"name": e.name, "type": type(e).__name__} for e in case.elements],
     }

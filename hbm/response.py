@@ -21,6 +21,7 @@ from continuation import Arclength, ArclengthOptions
 from .case import Case, CaseError
 from .energy import energy_balance
 from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
+from .jumps import predict_jumps
 from .newton import newton
 from .residual import HarmonicBalance
 from .stability import StabilityOptions, point_stability
@@ -54,6 +55,10 @@ class FRFResult:
     iterations : ndarray of int, shape (n_points,)
     status, message : str
         ``finished`` / ``failed`` / ``max_steps`` and a one-line explanation.
+    jumps : dict or None
+        Per output, the predicted jumps of slow up and down sweeps
+        (:func:`hbm.jumps.predict_jumps`, landing amplitudes solved exactly); ``None`` when
+        the stability was not computed.
     """
 
     freq_hz: np.ndarray
@@ -69,6 +74,7 @@ class FRFResult:
     n_rejected: int
     solve_seconds: float
     settings: dict = field(default_factory=dict)
+    jumps: dict | None = None
 
     @property
     def ok(self) -> bool:
@@ -240,8 +246,46 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             h1 = np.zeros(Xs.shape[0])
         mx = max_abs(basis, xd.T)
         outputs[name] = OutputSeries(h1, mx)
-    return FRFResult(np.array(pts_w) / (2 * np.pi), outputs, Xs, basis, stable, folds,
-                     np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings)
+    freq_hz = np.array(pts_w) / (2 * np.pi)
+    jumps = None
+    if stable is not None:
+        land = _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
+        jumps = {}
+        for name, dof in out_dofs.items():
+            def refine(i0, i1, f, dof=dof):
+                X = land(i0, i1, f)
+                return None if X is None else output_amplitudes(basis, X[:, dof])[0]
+            jumps[name] = predict_jumps(freq_hz, outputs[name].h1, stable, folds, refine=refine)
+    return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
+                     np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
+                     jumps)
+
+
+def _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
+    """``land(i0, i1, f_hz) -> X`` (n_coef, n) or ``None``: the stable solution at ``f_hz``
+    by Newton from the path interpolated linearly between points ``i0`` and ``i1``.
+
+    Results are cached (one solve per landing, shared by all outputs); ``None`` when Newton
+    fails or lands on an unstable solution.
+    """
+    cache = {}
+
+    def land(i0, i1, f_hz):
+        key = (i0, i1, float(f_hz))
+        if key not in cache:
+            w = 2 * np.pi * f_hz
+            df = freq_hz[i1] - freq_hz[i0]
+            t = 0.0 if df == 0 else min(max((f_hz - freq_hz[i0]) / df, 0.0), 1.0)
+            X0 = Xs[i0] + t * (Xs[i1] - Xs[i0])
+            fun = lambda x: problem.residual(x.reshape(X0.shape), w)[:2]
+            res = newton(fun, X0.ravel(), scale=xscale, r_scale=r_scale)
+            X = res.x.reshape(X0.shape) if res.converged else None
+            if X is not None and not point_stability(problem, X, w, stability_options).stable:
+                X = None
+            cache[key] = X
+        return cache[key]
+
+    return land
 
 
 def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform=None):
