@@ -51,8 +51,8 @@ response on a time scale longer than the period.  The filter keeps the ``2n`` ei
 
 The strip, rather than eigenvector centrality alone, is what makes the neglect of the
 :math:`\lambda`-dependence of hysteretic forces consistent: the friction's damping enters
-:math:`J` as a coupling of cosine and sine blocks, :math:`h w\,d`, like a structural
-(complex-stiffness) damping; the members of a family are then no longer exact shifted copies,
+:math:`J` only as an antisymmetric coupling :math:`\pm d_h` of the cosine and sine blocks
+(not in :math:`\Delta_1`), like a structural (complex-stiffness) damping; the members of a family are then no longer exact shifted copies,
 and only the slow member carries the friction damping with the right sign (the fast members
 of one root are spuriously unstable, a known defect of hysteretic damping in the time domain).
 
