@@ -1,6 +1,7 @@
 """Command line.
 
-``hbm frf CASE.toml -o OUTDIR [--harmonics H] [--samples N] [--fmin F] [--fmax F]``;
+``hbm frf CASE.toml -o OUTDIR [--harmonics H] [--samples N] [--fmin F] [--fmax F]
+[--no-stability]``;
 ``hbm timesim CASE.toml --freq-hz F -o OUTDIR [--steps N] [--tol T] [--max-periods P]
 [--periods P --switch-off-at S] [--alpha A]``.
 
@@ -65,6 +66,8 @@ def build_parser():
     f.add_argument("case", help="case file (TOML)")
     f.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     f.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    f.add_argument("--no-stability", dest="stability", action="store_false",
+                   help="skip the Hill stability of the points (empty 'stable' column)")
     _add_analysis_options(f)
     t = sub.add_parser("timesim", help="time-domain reference at one frequency (steady state or transient)")
     t.add_argument("case", help="case file (TOML)")
@@ -91,7 +94,8 @@ def cmd_frf(args) -> int:
     from .report import write_frf
     case = load_case(args.case)
     res = frf(case, harmonics=args.harmonics, samples=args.samples, fmin=args.fmin, fmax=args.fmax,
-              transform=args.transform, progress=None if args.quiet else _progress)
+              transform=args.transform, progress=None if args.quiet else _progress,
+              stability=args.stability)
     if not args.quiet:
         sys.stderr.write("\r" + " " * 40 + "\r")
     summary = write_frf(case, res, args.out)
@@ -102,6 +106,12 @@ def cmd_frf(args) -> int:
             print(f"  peak {name}: {p['amplitude']:.6g} at {p['freq_hz']:.6g} Hz")
     if summary["folds"]:
         print("  folds at " + ", ".join(f"{f:.6g}" for f in summary["folds"]) + " Hz")
+    for name, jumps in (summary["jumps"] or {}).items():
+        for way in ("up", "down"):
+            for j in jumps[way]:
+                after = "no stable branch" if j["amplitude_after"] is None else f"{j['amplitude_after']:.6g}"
+                print(f"  jump {name} (sweep {way}) at {j['from_hz']:.6g} Hz: "
+                      f"{j['amplitude_before']:.6g} -> {after}")
     if summary["max_energy_error"] is not None:
         print(f"  max energy-balance error {summary['max_energy_error']:.2e}")
     print(f"  wrote {args.out}/frf.csv, frf.png, summary.json")

@@ -1,7 +1,9 @@
 """Write an FRF to disk: ``frf.csv``, ``summary.json`` and ``frf.png`` (CLI contract of DESIGN.md).
 
 ``frf.csv`` columns: ``freq_hz``, then ``NAME_h1`` and ``NAME_max`` per output, then ``stable``
-(1/0, empty when not computed); rows follow the continuation path.
+(1/0, empty when not computed); rows follow the continuation path.  ``summary.json`` adds
+``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.jumps`) when the
+stability was computed.  ``frf.png`` draws unstable parts of the path dashed.
 """
 from __future__ import annotations
 
@@ -10,6 +12,8 @@ import json
 from pathlib import Path
 
 import numpy as np
+
+from .jumps import predict_jumps
 
 
 def peaks(freq: np.ndarray, amp: np.ndarray) -> list:
@@ -41,6 +45,15 @@ def write_csv(res, path: Path) -> None:
             w.writerow(row)
 
 
+def _jumps(res):
+    """The result's predicted jumps, or computed from the path (interpolated landings)."""
+    if res.stable is None:
+        return None
+    if getattr(res, "jumps", None) is not None:
+        return res.jumps
+    return {n: predict_jumps(res.freq_hz, o.h1, res.stable, res.folds_hz) for n, o in res.outputs.items()}
+
+
 def summary_dict(case, res, extra=None) -> dict:
     d = {
         "case": case.name,
@@ -55,6 +68,9 @@ def summary_dict(case, res, extra=None) -> dict:
         "solve_seconds": round(float(res.solve_seconds), 6),
         "peaks": {n: peaks(res.freq_hz, o.h1) for n, o in res.outputs.items()},
         "folds": [float(f) for f in res.folds_hz],
+        "stability_computed": res.stable is not None,
+        "n_unstable": None if res.stable is None else int(np.count_nonzero(~res.stable)),
+        "jumps": _jumps(res),
         "max_energy_error": float(res.energy_error.max()) if res.energy_error.size else None,
         "elements": [{"name": e.name, "type": type(e).__name__} for e in case.elements],
     }
@@ -63,14 +79,36 @@ def summary_dict(case, res, extra=None) -> dict:
     return d
 
 
+def _runs(stable: np.ndarray) -> list:
+    """Index ranges ``(a, b, is_stable)`` of equal stability, each sharing its first point
+    with the previous range so that the drawn curve has no gaps."""
+    out, a = [], 0
+    for i in range(1, stable.size + 1):
+        if i == stable.size or stable[i] != stable[a]:
+            out.append((max(a - 1, 0), i - 1, bool(stable[a])))
+            a = i
+    return out
+
+
 def write_plot(res, path: Path, title: str) -> None:
+    """FRF plot: first harmonic (thick) and max |x| (thin) per output; unstable parts dashed."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
+    stable = np.ones(res.freq_hz.size, dtype=bool) if res.stable is None else np.asarray(res.stable)
+    runs = _runs(stable)
     for name, o in res.outputs.items():
-        line, = ax.plot(res.freq_hz, o.h1, label=f"{name} (1st harmonic)")
-        ax.plot(res.freq_hz, o.max, "--", color=line.get_color(), lw=0.8, label=f"{name} (max |x|)")
+        color = None
+        for curve, lw, label in ((o.h1, 1.5, f"{name} (1st harmonic)"), (o.max, 0.8, f"{name} (max |x|)")):
+            first = True
+            for a, b, ok in runs:
+                line, = ax.plot(res.freq_hz[a:b + 1], curve[a:b + 1], "-" if ok else "--", lw=lw,
+                                color=color, label=label if first else None)
+                color = line.get_color()
+                first = False
+    if res.stable is not None and not stable.all():
+        ax.plot([], [], "k--", lw=1.0, label="unstable (Hill)")
     for f in res.folds_hz:
         ax.axvline(f, color="0.6", lw=0.6, ls=":")
     ax.set_xlabel("frequency (Hz)")

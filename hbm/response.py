@@ -4,7 +4,8 @@ The FRF is the branch of solutions of :math:`R(X, w) = 0` (:mod:`hbm.residual`) 
 ``fmin`` to ``fmax`` by :mod:`continuation` on ``x = [X.ravel(), w]`` with per-unknown
 scaling.  The first point is solved by Newton from the linear response with the elements
 stuck; failing that, from the response without elements; failing that, by ramping the
-excitation.  Every converged point is checked by the energy balance (:mod:`hbm.energy`).
+excitation.  Every converged point is checked by the energy balance (:mod:`hbm.energy`)
+and, unless switched off, by Hill's method (:mod:`hbm.stability`).
 Outputs per point: first-harmonic amplitude ``h1 = sqrt(Xc1^2 + Xs1^2)`` and ``max`` of
 ``|x(t)|`` over a period on a fine grid.
 """
@@ -20,8 +21,10 @@ from continuation import Arclength, ArclengthOptions
 from .case import Case, CaseError
 from .energy import energy_balance
 from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
+from .jumps import predict_jumps
 from .newton import newton
 from .residual import HarmonicBalance
+from .stability import StabilityOptions, point_stability
 from .transforms import make_transform
 
 
@@ -44,13 +47,18 @@ class FRFResult:
     outputs : dict of str -> OutputSeries
     X : ndarray, shape (n_points, n_coef, n)
         Harmonic coefficients of every point.
-    stable : ndarray of bool or None
+    stable : ndarray of bool, shape (n_points,), or None
+        Hill stability of every point (``None`` when not computed).
     folds_hz : list of float
     energy_error : ndarray, shape (n_points,)
         Relative energy-balance error per point.
     iterations : ndarray of int, shape (n_points,)
     status, message : str
         ``finished`` / ``failed`` / ``max_steps`` and a one-line explanation.
+    jumps : dict or None
+        Per output, the predicted jumps of slow up and down sweeps
+        (:func:`hbm.jumps.predict_jumps`, landing amplitudes solved exactly); ``None`` when
+        the stability was not computed.
     """
 
     freq_hz: np.ndarray
@@ -66,6 +74,7 @@ class FRFResult:
     n_rejected: int
     solve_seconds: float
     settings: dict = field(default_factory=dict)
+    jumps: dict | None = None
 
     @property
     def ok(self) -> bool:
@@ -176,7 +185,8 @@ def build_problem(case: Case, basis: FourierBasis, transform: str) -> HarmonicBa
 
 
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
-        progress=None, options: ArclengthOptions | None = None) -> FRFResult:
+        progress=None, options: ArclengthOptions | None = None, stability: bool = True,
+        stability_options: StabilityOptions | None = None) -> FRFResult:
     """Trace the FRF of ``case``.
 
     Parameters
@@ -193,6 +203,10 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     progress : callable, optional
         Called as ``progress(n_points, freq_hz)`` after every converged point.
     options : ArclengthOptions, optional
+    stability : bool
+        Decide the stability of every point by Hill's method (``FRFResult.stable``);
+        ``False`` leaves ``stable`` as ``None``.
+    stability_options : StabilityOptions, optional
 
     Returns
     -------
@@ -208,7 +222,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     xscale = _unknown_scale(problem, case, w_lo, w_hi)
     r_scale = _residual_scale(problem, w_lo)
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
-                "transform": problem.nl.transform.name}
+                "transform": problem.nl.transform.name, "stability": bool(stability)}
     shape = problem.Fex.shape
     out_dofs = case.analysis.outputs
     pts_X, pts_w, its, eerr = [], [], [], []
@@ -239,6 +253,10 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             message = f"stopped after max_points={case.analysis.max_points} points at {pts_w[-1] / (2 * np.pi):.6g} Hz"
         folds = [f / (2 * np.pi) for f in solver.folds]
         n_rej = solver.n_rejected
+    stable = None
+    if stability:
+        stable = np.array([point_stability(problem, X, w, stability_options).stable
+                           for X, w in zip(pts_X, pts_w)], dtype=bool)
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
     outputs = {}
@@ -251,8 +269,46 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             h1 = np.zeros(Xs.shape[0])
         mx = max_abs(basis, xd.T)
         outputs[name] = OutputSeries(h1, mx)
-    return FRFResult(np.array(pts_w) / (2 * np.pi), outputs, Xs, basis, None, folds,
-                     np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings)
+    freq_hz = np.array(pts_w) / (2 * np.pi)
+    jumps = None
+    if stable is not None:
+        land = _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
+        jumps = {}
+        for name, g in out_dofs.items():
+            def refine(i0, i1, f, g=g):
+                X = land(i0, i1, f)
+                return None if X is None else output_amplitudes(basis, X @ g)[0]
+            jumps[name] = predict_jumps(freq_hz, outputs[name].h1, stable, folds, refine=refine)
+    return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
+                     np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
+                     jumps)
+
+
+def _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
+    """``land(i0, i1, f_hz) -> X`` (n_coef, n) or ``None``: the stable solution at ``f_hz``
+    by Newton from the path interpolated linearly between points ``i0`` and ``i1``.
+
+    Results are cached (one solve per landing, shared by all outputs); ``None`` when Newton
+    fails or lands on an unstable solution.
+    """
+    cache = {}
+
+    def land(i0, i1, f_hz):
+        key = (i0, i1, float(f_hz))
+        if key not in cache:
+            w = 2 * np.pi * f_hz
+            df = freq_hz[i1] - freq_hz[i0]
+            t = 0.0 if df == 0 else min(max((f_hz - freq_hz[i0]) / df, 0.0), 1.0)
+            X0 = Xs[i0] + t * (Xs[i1] - Xs[i0])
+            fun = lambda x: problem.residual(problem.expand(x), w)[:2]
+            res = newton(fun, problem.unknowns(X0), scale=xscale, r_scale=r_scale)
+            X = problem.expand(res.x) if res.converged else None
+            if X is not None and not point_stability(problem, X, w, stability_options).stable:
+                X = None
+            cache[key] = X
+        return cache[key]
+
+    return land
 
 
 def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform=None):
