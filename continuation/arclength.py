@@ -244,8 +244,8 @@ class Arclength:
                 consecutive += 1
                 if reason.startswith("the tangent turned"):
                     angle_reject = (ds, angle)
-                else:
-                    angle_reject = None
+                # other reasons keep the memory of a turn: at a corner the hyperplane
+                # corrector fails (branch jump) at every ds, only the sphere sees the turn
                 ds *= 0.5
                 if ds < self.ds_min:
                     self._fail(f"step size fell below ds_min={self.ds_min:.3g} at "
@@ -279,9 +279,13 @@ class Arclength:
                 factor = min(factor, max(o.shrink_min, 0.8 * math.radians(o.max_angle_deg) / angle))
             if consecutive:
                 factor = min(factor, 1.0)
+            # a step shorter than the last rejected turn approaches a corner: keep the
+            # memory, so that the same turn at a smaller ds is recognised as a kink
+            # (otherwise the path creeps towards the corner in ever shorter steps)
+            if angle_reject is not None and not ds < angle_reject[0]:
+                angle_reject = None
             ds = min(max(ds * factor, self.ds_min), self.ds_max)
             consecutive = 0
-            angle_reject = None
 
     def _step(self, xs, t, ds, angle_reject, sphere):
         """Predict and correct one step; return ``(c, t_new, angle, reason, on_bound)``.

@@ -38,6 +38,7 @@ class Element:
     keys: tuple = ()
     max_passes: int = 20
     closure_tol: float = 1e-12
+    quantities: tuple = ()      # names of the per-period outputs of ``summary``
 
     def __init__(self, gather, params, name):
         G = np.array(gather, dtype=float, ndmin=2)
@@ -86,6 +87,56 @@ class Element:
     def linear_stiffness(self) -> np.ndarray:
         """Tangent stiffness (n_local, n_local) of the element at rest (stuck, closed)."""
         raise NotImplementedError
+
+    def summary(self, f: np.ndarray, z: np.ndarray) -> dict:
+        """Per-period outputs (keys ``quantities``) of one closed period.
+
+        Parameters
+        ----------
+        f : ndarray, shape (N, n_local)
+            Forces returned by ``march``.
+        z : ndarray, shape (N, n_input)
+            The sampled inputs that produced them (coordinates, then velocities).
+
+        Returns
+        -------
+        dict of str -> float
+        """
+        raise NotImplementedError(f"{type(self).__name__} has no per-period outputs")
+
+
+def slider_summary(f, u, kt) -> dict:
+    r"""Per-period outputs of a spring ``kt`` in series with a slider on one coordinate.
+
+    The slider position is :math:`w = u - f / k_t`; a sample slipped when the slider moved
+    in the step that reached it, :math:`|w_j - w_{j-1}| > 10^{-9} (\max|u| + \max|f| / k_t)`
+    (a stuck step moves it by round-off only).  The dissipation is the work of the force on
+    the slider over the closed period, :math:`\sum_j f_j (w_j - w_{j-1})`, the discrete
+    form of :math:`\oint f\, dw` for the return mapping (which slips at the end-of-step force).
+
+    Parameters
+    ----------
+    f, u : ndarray, shape (N,)
+        Force and coordinate samples of one closed period.
+    kt : float
+        Stick stiffness, > 0.
+
+    Returns
+    -------
+    dict
+        ``slip_fraction`` (fraction of samples that slipped), ``force_amplitude``
+        (``max |f|``), ``dissipation`` (J per period).
+    """
+    f = np.asarray(f, dtype=float)
+    u = np.asarray(u, dtype=float)
+    w = u - f / kt
+    dw = w - np.roll(w, 1)
+    tol = 1e-9 * (np.abs(u).max() + np.abs(f).max() / kt)
+    return {
+        "slip_fraction": float(np.mean(np.abs(dw) > tol)),
+        "force_amplitude": float(np.abs(f).max()),
+        "dissipation": float(np.sum(f * dw)),
+    }
 
 
 def require_keys(spec: dict, allowed, required, where: str) -> None:
@@ -138,23 +189,69 @@ def dof_number(d, n_dof, dof_index, where) -> int:
     return int(d)
 
 
+def _is_pair(item) -> bool:
+    return isinstance(item, (list, tuple))
+
+
+def coordinate_row(spec, n_dof, dof_index=None, where="element") -> np.ndarray:
+    """One gather-matrix row (n_dof,) from a coordinate spec.
+
+    Accepted forms (a DOF is an index or, with a name map, a name):
+
+    - ``a`` or ``[a]``: ``u = q_a``;
+    - ``[a, b]``: ``u = q_a - q_b``;
+    - ``[[a, ca], [b, cb], ...]``: ``u = ca q_a + cb q_b + ...`` (pairs of DOF and
+      coefficient, for directions that are not along the model axes, e.g. an inclined
+      contact ``t1 = [[0, 0.866], [1, 0.5]]``); each DOF at most once, coefficients finite
+      and not all zero.
+
+    Raises
+    ------
+    ValueError
+        A malformed spec, with ``where`` and the spec in the message.
+    """
+    row = np.zeros(n_dof)
+    items = spec if isinstance(spec, (list, tuple)) else [spec]
+    if items and all(_is_pair(it) for it in items):
+        seen = set()
+        for it in items:
+            if len(it) != 2:
+                raise ValueError(f"{where}: a weighted coordinate is a list of [dof, coefficient] pairs, "
+                                 f"got {it!r} in {spec!r}")
+            a = dof_number(it[0], n_dof, dof_index, where)
+            c = _number(f"{where}: coefficient of DOF {it[0]!r}", it[1])
+            if a in seen:
+                raise ValueError(f"{where}: DOF {it[0]!r} appears twice in {spec!r}")
+            seen.add(a)
+            row[a] = c
+        if not np.any(row):
+            raise ValueError(f"{where}: all coefficients are zero in {spec!r}")
+        return row
+    if any(_is_pair(it) for it in items):
+        raise ValueError(f"{where}: mixes DOFs and [dof, coefficient] pairs in {spec!r} "
+                         f"(use a, [a, b] or [[a, ca], [b, cb], ...])")
+    if len(items) not in (1, 2):
+        raise ValueError(f"{where}: dofs must be a, [a], [a, b] or [[a, ca], [b, cb], ...], got {spec!r}")
+    a = dof_number(items[0], n_dof, dof_index, where)
+    row[a] += 1.0
+    if len(items) == 2:
+        b = dof_number(items[1], n_dof, dof_index, where)
+        if b == a:
+            raise ValueError(f"{where}: dofs [a, b] must differ, got {spec!r}")
+        row[b] -= 1.0
+    return row
+
+
 def coordinate_rows(specs, n_dof, dof_index=None, where="element") -> np.ndarray:
-    """Gather matrix rows for coordinates given as ``a``, ``[a]`` or ``[a, b]`` (``q_a - q_b``).
+    """Gather matrix rows for coordinates given as ``a``, ``[a]``, ``[a, b]`` (``q_a - q_b``)
+    or ``[[a, ca], [b, cb], ...]`` (``ca q_a + cb q_b + ...``); see :func:`coordinate_row`.
+
+    ``where`` may be a string (used for every row) or a sequence with one label per row.
 
     Returns
     -------
     ndarray, shape (len(specs), n_dof)
     """
-    G = np.zeros((len(specs), n_dof))
-    for r, spec in enumerate(specs):
-        items = spec if isinstance(spec, (list, tuple)) else [spec]
-        if len(items) not in (1, 2):
-            raise ValueError(f"{where}: dofs must be [a] or [a, b], got {spec!r}")
-        a = dof_number(items[0], n_dof, dof_index, where)
-        G[r, a] += 1.0
-        if len(items) == 2:
-            b = dof_number(items[1], n_dof, dof_index, where)
-            if b == a:
-                raise ValueError(f"{where}: dofs [a, b] must differ, got {spec!r}")
-            G[r, b] -= 1.0
-    return G
+    labels = [where] * len(specs) if isinstance(where, str) else list(where)
+    return np.array([coordinate_row(s, n_dof, dof_index, w) for s, w in zip(specs, labels)],
+                    dtype=float).reshape(len(specs), n_dof)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative
+from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
 from .kinds import COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
 from .laws.coulomb import LINEAR, ARCTAN
 
@@ -27,6 +27,7 @@ class CoulombStickSlip(Element):
     needs_mean = False
     coord_names = ("u",)
     keys = ("type", "dofs", "kt", "normal_load", "mu_static", "mu_kinetic", "name")
+    quantities = ("slip_fraction", "force_amplitude", "dissipation")
 
     def __init__(self, gather, kt, normal_load, mu_static, mu_kinetic, name="coulomb_stick_slip"):
         mu_s = non_negative("mu_static", mu_static)
@@ -50,6 +51,11 @@ class CoulombStickSlip(Element):
         stuck = self.params[1] * self.params[2] > 0.0
         return np.array([[self.params[0] if stuck else 0.0]])
 
+    def summary(self, f, z):
+        """``slip_fraction``, ``force_amplitude``, ``dissipation`` of one closed period
+        (:func:`elements.base.slider_summary`); ``f`` (N, 1), ``z`` (N, 1)."""
+        return slider_summary(np.asarray(f)[:, 0], np.asarray(z)[:, 0], float(self.params[0]))
+
 
 class CoulombRegularised(Element):
     """Velocity-regularised Coulomb friction (seed 001, eq. 2.2), memory-less in ``u``.
@@ -66,6 +72,7 @@ class CoulombRegularised(Element):
     needs_mean = False
     coord_names = ("u",)
     keys = ("type", "dofs", "slip_force", "v_r", "law", "name")
+    quantities = ("slip_fraction", "force_amplitude", "dissipation")
     laws = {"linear": LINEAR, "arctan": ARCTAN}
 
     def __init__(self, gather, slip_force, v_r, law="linear", name="coulomb_regularised"):
@@ -94,3 +101,20 @@ class CoulombRegularised(Element):
         F0, vr = self.params[0], self.params[1]
         c = F0 / vr if self.law == "linear" else 2.0 * F0 / (np.pi * vr)
         return np.array([[c]])
+
+    def summary(self, f, z):
+        r"""Per-period outputs; ``f`` (N, 1), ``z`` (N, 2) = ``[u, v]``.
+
+        ``slip_fraction``: fraction of samples with ``|v| >= v_r`` (sliding at the full
+        force, outside the regularisation zone); ``force_amplitude``: ``max |f|``;
+        ``dissipation``: :math:`\oint f\,du` by the trapezoidal rule over the closed
+        period, :math:`\sum_j \tfrac12 (f_j + f_{j-1})(u_j - u_{j-1})`.
+        """
+        f = np.asarray(f, dtype=float)[:, 0]
+        z = np.asarray(z, dtype=float)
+        u, v = z[:, 0], z[:, 1]
+        return {
+            "slip_fraction": float(np.mean(np.abs(v) >= self.params[1])),
+            "force_amplitude": float(np.abs(f).max()),
+            "dissipation": float(np.sum(0.5 * (f + np.roll(f, 1)) * (u - np.roll(u, 1)))),
+        }

@@ -11,9 +11,24 @@ from .kinds import FRICTION3D
 class Friction3D(Element):
     """Macroslip point contact on local coordinates (t1, t2, n), or (t1, n) without ``t2``.
 
-    Case keys: ``type``, ``dofs = {t1 = [a, b] or a, t2 = ..., n = ...}`` (``[a, b]`` means
-    ``q_a - q_b``; ``t2`` optional), ``kt``, ``kn`` (> 0), ``mu`` (>= 0),
-    ``normal_preload`` (``N0 >= 0``), optional ``name``.
+    Case keys: ``type``, ``dofs = {t1 = ..., t2 = ..., n = ...}`` (``t2`` optional), ``kt``,
+    ``kn`` (> 0), ``mu`` (>= 0), ``normal_preload`` (``N0 >= 0``), optional ``name``.
+
+    Each local coordinate is a linear combination of model DOFs, one row of the gather
+    matrix (:func:`elements.base.coordinate_row`):
+
+    - ``a`` or ``[a]``: ``q_a``;  ``[a, b]``: ``q_a - q_b`` (contact between two bodies whose
+      DOFs are along the contact axes);
+    - ``[[a, ca], [b, cb], ...]``: ``ca q_a + cb q_b + ...``, pairs of DOF and coefficient,
+      for contact directions not along the model axes.  A mass with DOFs x (0) and y (1)
+      against a wall inclined by 30 degrees::
+
+          dofs = { t1 = [[0, 0.8660254], [1, 0.5]], n = [[0, -0.5], [1, 0.8660254]] }
+
+      The coefficients are taken as given (not normalised): unit direction vectors give
+      ``kt``, ``kn`` their physical meaning.  Malformed forms (a pair that is not
+      ``[dof, number]``, a DOF twice, all coefficients zero, pairs mixed with bare DOFs)
+      are rejected with the coordinate named (``dofs.t1``).
 
     The normal load is ``N = max(N0 + kn u_n, 0)`` (``u_n > 0`` closes); the element force
     along ``n`` is ``N - N0`` (zero at rest, ``-N0`` while open).  The tangential force obeys
@@ -41,6 +56,8 @@ class Friction3D(Element):
     needs_mean = True       # normal-load variation gives mean forces
     keys = ("type", "dofs", "kt", "kn", "mu", "normal_preload", "name")
     dof_keys = ("t1", "t2", "n")
+    quantities = ("normal_load_min", "normal_load_max", "open_fraction", "slip_fraction",
+                  "dissipation")
     max_passes = 1000
     closure_tol = 1e-12
 
@@ -65,7 +82,8 @@ class Friction3D(Element):
                              f"got {dofs!r}")
         require_keys(dofs, cls.dof_keys, ("t1", "n"), f"{where}: dofs")
         names = [k for k in cls.dof_keys if k in dofs]
-        G = coordinate_rows([dofs[k] for k in names], n_dof, dof_index, where)
+        G = coordinate_rows([dofs[k] for k in names], n_dof, dof_index,
+                            [f"{where}: dofs.{k}" for k in names])
         return cls(G, spec["kt"], spec["kn"], spec["mu"], spec["normal_preload"],
                    spec.get("name", "friction3d"))
 

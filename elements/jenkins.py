@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative
+from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
 from .kinds import JENKINS
 
 
@@ -26,6 +26,7 @@ class Jenkins(Element):
     needs_mean = False
     coord_names = ("u",)
     keys = ("type", "dofs", "kt", "slip_force", "name")
+    quantities = ("slip_fraction", "force_amplitude", "dissipation")
 
     def __init__(self, gather, kt, slip_force, name="jenkins"):
         super().__init__(gather, np.array([positive("kt", kt), non_negative("slip_force", slip_force)]), name)
@@ -50,3 +51,8 @@ class Jenkins(Element):
 
     def linear_stiffness(self):
         return np.array([[self.kt]])
+
+    def summary(self, f, z):
+        """``slip_fraction``, ``force_amplitude``, ``dissipation`` of one closed period
+        (:func:`elements.base.slider_summary`); ``f`` (N, 1), ``z`` (N, 1)."""
+        return slider_summary(np.asarray(f)[:, 0], np.asarray(z)[:, 0], self.kt)

@@ -7,9 +7,13 @@ Schema (``../shared/DESIGN.md``)::
     [[element]]   type = "<registry key>", dofs = ..., law keys
     [excitation]  dofs = [...], amplitude = [...]        (cosine at the first harmonic, N)
                   base = { dofs = [...], amplitude = [...] }   (imposed support motion, m)
-    [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], outputs = {name = dof},
-                  max_points, transform
-                  (an output is a DOF index or name, or [a, b] for the relative motion q_a - q_b)
+    [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], max_points, transform,
+                  outputs = {name = dof, name = [a, b], name = "ELEMENT.QUANTITY"}
+
+An output is a DOF (index or name), ``[a, b]`` for the relative motion ``q_a - q_b`` (both:
+first-harmonic amplitude and max over a period), or a per-period quantity of a named element,
+``"contact.normal_load_min"`` (the element's ``name`` key, then one of its class's
+``quantities``); a string that is a DOF name is a DOF.
 
 Every unknown key is an error naming the key and the file.  Errors are :class:`CaseError`
 (a ``ValueError``) with a one-line message.
@@ -53,8 +57,12 @@ class Excitation:
 
 @dataclass(frozen=True)
 class Analysis:
-    """Analysis settings: harmonic list, samples per period, frequency range (Hz), and
-    ``outputs``: name -> gather row (n,) (a DOF, or ``q_a - q_b``)."""
+    """Analysis settings: harmonic list, samples per period, frequency range (Hz), outputs.
+
+    ``outputs`` maps output names to gather rows (n,) (a DOF, or ``q_a - q_b``);
+    ``element_outputs`` maps output names to ``(element index, quantity)`` for the outputs
+    written ``"ELEMENT.QUANTITY"``.
+    """
 
     harmonics: np.ndarray
     time_samples: int
@@ -62,6 +70,7 @@ class Analysis:
     outputs: dict
     max_points: int = 2000
     transform: str = "auto"
+    element_outputs: dict = field(default_factory=dict)   # name -> (element index, quantity)
 
 
 @dataclass(frozen=True)
@@ -262,12 +271,40 @@ def _analysis(t, model, elements, path):
     outs = t["outputs"]
     if not isinstance(outs, dict) or not outs:
         raise CaseError(f"{path}: [analysis] outputs must be a table name = dof")
-    outputs = {str(k): _output_row(k, v, model, path) for k, v in outs.items()}
+    outputs, element_outputs = {}, {}
+    for k, v in outs.items():
+        if isinstance(v, str) and v not in model.dof_index and "." in v:
+            element_outputs[str(k)] = _element_output(k, v, elements, path)
+        else:
+            outputs[str(k)] = _output_row(k, v, model, path)
+    columns = [f"{k}_{c}" for k in outputs for c in ("h1", "max")] + list(element_outputs)
+    for c in columns:
+        if columns.count(c) > 1 or c in ("freq_hz", "stable"):
+            raise CaseError(f"{path}: [analysis] outputs: column {c!r} of frf.csv would appear twice; "
+                            f"rename an output")
     mp = _number(t.get("max_points", 2000), "[analysis] max_points", path, positive=True, integer=True)
     tr = t.get("transform", "auto")
     if tr not in ("auto", "dft", "numpy", "fftw"):
         raise CaseError(f"{path}: [analysis] transform must be auto, dft, numpy or fftw, got {tr!r}")
-    return Analysis(h, int(N), (float(lo), float(hi)), outputs, int(mp), tr)
+    return Analysis(h, int(N), (float(lo), float(hi)), outputs, int(mp), tr, element_outputs)
+
+
+def _element_output(key, value, elements, path):
+    """``(element index, quantity)`` of an output written ``"ELEMENT.QUANTITY"``."""
+    where = f"{path}: [analysis] outputs.{key}"
+    ename, _, qty = value.rpartition(".")
+    hits = [i for i, e in enumerate(elements) if e.name == ename]
+    if not hits:
+        known = ", ".join(repr(e.name) for e in elements) or "none"
+        raise CaseError(f"{where}: {value!r} names no DOF and no element {ename!r} (elements: {known})")
+    if len(hits) > 1:
+        raise CaseError(f"{where}: element name {ename!r} is not unique; give the elements distinct names")
+    e = elements[hits[0]]
+    if qty not in e.quantities:
+        has = ", ".join(e.quantities) or "none"
+        raise CaseError(f"{where}: element {ename!r} ({type(e).__name__}) has no output {qty!r} "
+                        f"(its outputs: {has})")
+    return hits[0], qty
 
 
 def case_from_dict(data: dict, path: str = "<case>", base_dir: Path | None = None) -> Case:

@@ -1,9 +1,10 @@
 """Write an FRF to disk: ``frf.csv``, ``summary.json`` and ``frf.png`` (CLI contract of DESIGN.md).
 
-``frf.csv`` columns: ``freq_hz``, then ``NAME_h1`` and ``NAME_max`` per output, then ``stable``
-(1/0, empty when not computed); rows follow the continuation path.  ``summary.json`` adds
-``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.jumps`) when the
-stability was computed.  ``frf.png`` draws unstable parts of the path dashed.
+``frf.csv`` columns: ``freq_hz``, then ``NAME_h1`` and ``NAME_max`` per DOF output, then one
+column ``NAME`` per element output (a per-period scalar such as ``contact.slip_fraction``), then
+``stable`` (1/0, empty when not computed); rows follow the continuation path.  ``summary.json``
+adds ``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.jumps`) when
+the stability was computed.  ``frf.png`` draws unstable parts of the path dashed.
 """
 from __future__ import annotations
 
@@ -33,14 +34,16 @@ def peaks(freq: np.ndarray, amp: np.ndarray) -> list:
 
 def write_csv(res, path: Path) -> None:
     names = list(res.outputs)
+    enames = list(getattr(res, "element_outputs", {}))
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")] + ["stable"])
+        w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")] + enames + ["stable"])
         for i, f in enumerate(res.freq_hz):
             row = [f"{f:.10g}"]
             for n in names:
                 o = res.outputs[n]
                 row += [f"{o.h1[i]:.10g}", f"{o.max[i]:.10g}"]
+            row += [f"{res.element_outputs[n][i]:.10g}" for n in enames]
             row.append("" if res.stable is None else str(int(bool(res.stable[i]))))
             w.writerow(row)
 
@@ -73,6 +76,8 @@ def summary_dict(case, res, extra=None) -> dict:
         "jumps": _jumps(res),
         "max_energy_error": float(res.energy_error.max()) if res.energy_error.size else None,
         "elements": [{"name": e.name, "type": type(e).__name__} for e in case.elements],
+        "element_outputs": {n: {"min": float(v.min()), "max": float(v.max())} if v.size else None
+                            for n, v in getattr(res, "element_outputs", {}).items()},
     }
     if extra:
         d.update(extra)

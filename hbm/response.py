@@ -19,6 +19,7 @@ import numpy as np
 from continuation import Arclength, ArclengthOptions
 
 from .case import Case, CaseError
+from .element_outputs import element_output_series
 from .energy import energy_balance
 from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
 from .jumps import predict_jumps
@@ -53,6 +54,8 @@ class FRFResult:
     energy_error : ndarray, shape (n_points,)
         Relative energy-balance error per point.
     iterations : ndarray of int, shape (n_points,)
+    element_outputs : dict of str -> ndarray, shape (n_points,)
+        Per-period element quantities (``"ELEMENT.QUANTITY"`` outputs), :mod:`hbm.element_outputs`.
     status, message : str
         ``finished`` / ``failed`` / ``max_steps`` and a one-line explanation.
     jumps : dict or None
@@ -75,6 +78,7 @@ class FRFResult:
     solve_seconds: float
     settings: dict = field(default_factory=dict)
     jumps: dict | None = None
+    element_outputs: dict = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -134,8 +138,15 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
             except np.linalg.LinAlgError:
                 continue
             np.maximum(amp, np.abs(x), out=amp)
-    s = np.sqrt(np.maximum(amp_free, 1e-300) * np.maximum(amp_stuck, 1e-300))
-    s = np.maximum(s, 1e-6 * s.max() if s.max() > 0 else 1.0)
+    # a DOF that only the elements couple to the force (free response nil) takes its stuck
+    # amplitude, and one without any linear response (round-off) the largest scale: a
+    # geometric mean with nil or the 1e-6 floor inflates it in the arclength (the path creeps)
+    top = max(amp_free.max(), amp_stuck.max())
+    nil = 1e-9 * top if top > 0 else 1.0
+    af, ast = amp_free > nil, amp_stuck > nil
+    s = np.where(af & ast, np.sqrt(amp_free * amp_stuck), np.where(af, amp_free, amp_stuck))
+    smax = s.max() if s.max() > 0 else 1.0
+    s = np.where(af | ast, np.maximum(s, 1e-6 * smax), smax)
     return np.tile(s, problem.basis.n_coef)
 
 
@@ -279,9 +290,10 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
                 X = land(i0, i1, f)
                 return None if X is None else output_amplitudes(basis, X @ g)[0]
             jumps[name] = predict_jumps(freq_hz, outputs[name].h1, stable, folds, refine=refine)
+    eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
-                     jumps)
+                     jumps, eouts)
 
 
 def _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
