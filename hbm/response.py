@@ -96,6 +96,13 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
     return h, N, lo, hi, tr
 
 
+# Smallest per-DOF unknown scale, relative to the largest.  DOFs that the linear responses
+# leave at rest (by symmetry, e.g. the radial motion of a wedge damper in the in-phase mode)
+# still move through nonlinear effects (mean shifts from normal-load variation); with a floor
+# of 1e-6 the continuation measured those small motions as huge scaled steps and stalled.
+SCALE_FLOOR = 1e-2
+
+
 def _stuck_stiffness(case: Case) -> np.ndarray:
     K = np.zeros((case.n_dof, case.n_dof))
     for e in case.elements:
@@ -104,7 +111,8 @@ def _stuck_stiffness(case: Case) -> np.ndarray:
 
 
 def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
-    """Per-DOF amplitude scale: geometric mean of the stuck and free linear peak responses."""
+    """Per-DOF amplitude scale: geometric mean of the stuck and free linear peak responses
+    (the stuck one alone for DOFs that only the elements move)."""
     ws = np.linspace(w_lo, w_hi, 41)
     Ks = _stuck_stiffness(case)
     amp_free = np.zeros(case.n_dof)
@@ -120,7 +128,11 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
                 continue
             np.maximum(amp, np.abs(x), out=amp)
     s = np.sqrt(np.maximum(amp_free, 1e-300) * np.maximum(amp_stuck, 1e-300))
-    s = np.maximum(s, 1e-6 * s.max() if s.max() > 0 else 1.0)
+    # DOFs moved only through the elements (e.g. a damper body's internal DOFs) do not
+    # respond without them: their scale is the stuck response alone
+    only_stuck = amp_free <= 1e-12 * max(amp_free.max(), 1e-300)
+    s = np.where(only_stuck, amp_stuck, s)
+    s = np.maximum(s, SCALE_FLOOR * s.max() if s.max() > 0 else 1.0)
     return np.tile(s, problem.basis.n_coef)
 
 
