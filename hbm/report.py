@@ -41,6 +41,14 @@ def write_csv(res, path: Path) -> None:
             w.writerow(row)
 
 
+def _element_entry(e) -> dict:
+    """Name, type and (when the element has one) its static state, e.g. static normal loads."""
+    d = {"name": e.name, "type": type(e).__name__}
+    if hasattr(e, "static_state"):
+        d["static_state"] = e.static_state()
+    return d
+
+
 def summary_dict(case, res, extra=None) -> dict:
     d = {
         "case": case.name,
@@ -56,7 +64,7 @@ def summary_dict(case, res, extra=None) -> dict:
         "peaks": {n: peaks(res.freq_hz, o.h1) for n, o in res.outputs.items()},
         "folds": [float(f) for f in res.folds_hz],
         "max_energy_error": float(res.energy_error.max()) if res.energy_error.size else None,
-        "elements": [{"name": e.name, "type": type(e).__name__} for e in case.elements],
+        "elements": [_element_entry(e) for e in case.elements],
     }
     if extra:
         d.update(extra)
