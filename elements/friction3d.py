@@ -21,18 +21,11 @@ class Friction3D(Element):
 
     State layout (``nt`` = 1 or 2 tangential directions): ``[f_t (nt), f_n, u_t,prev (nt)]``.
 
-    Start of the march (``start_index``): the sample where the rest state reached from
-    ``q = 0`` violates the slip limit most, ``argmax_j (|u_t(t_j)| - mu N(t_j) / kt)``.  For
-    a slipping loop that is a reversal of the tangential motion (the largest ``|u_t|``; for
-    constant load exactly), so the rest state there is on (1D, constant load: exactly) or
-    close to the steady hysteresis loop and the march closes after one or a few passes.  For
-    a loop that sticks in the steady state the slider keeps a position that depends on the
-    history; this choice makes it the projection of the rest position onto the admissible
-    set (1D: exactly; ``0`` when the rest position is admissible), which depends
-    continuously on the motion.  (The former choice, the reversal of the centred motion
-    along its principal direction, gave a stuck state that jumped whenever a varying normal
-    load moved the binding sample away from that reversal: the residual was discontinuous
-    and continuation failed at the onset of slip.)  For 2D loops (elliptical motion) and a varying normal
+    Start of the march (``start_index``): the sample where the tangential motion reverses
+    along its principal direction (argmax of the projection of the centred ``u_t`` on the
+    leading eigenvector of its covariance).  The rest state reached there from ``q = 0`` is
+    then on (1D, constant load: exactly) or close to the steady hysteresis loop, so the march
+    closes after one or a few passes.  For 2D loops (elliptical motion) and a varying normal
     load the slider position is only forgotten geometrically, pass after pass: the component
     of the slider offset across a nearly fixed slip direction, and partial slip that shakes
     down towards an elastic loop, contract slowly (up to ~130 passes seen on random ellipses
@@ -97,12 +90,12 @@ class Friction3D(Element):
         return float(self.params[3])
 
     def start_index(self, u):
-        """The sample where the rest state from ``q = 0`` is furthest outside the slip limit,
-        ``argmax_j (|u_t,j| - mu N_j / kt)`` (see the class docstring)."""
-        u = np.asarray(u)
-        nt = self.n_tangential
-        reach = self.mu * np.maximum(self.normal_preload + self.kn * u[:, nt], 0.0) / self.kt
-        return int(np.argmax(np.linalg.norm(u[:, :nt], axis=1) - reach))
+        ut = np.asarray(u)[:, :self.n_tangential]
+        c = ut - ut.mean(axis=0)
+        if self.n_tangential == 1:
+            return int(np.argmax(c[:, 0]))
+        _, vecs = np.linalg.eigh(c.T @ c)
+        return int(np.argmax(c @ vecs[:, -1]))
 
     def march(self, z, dz):
         """Forces and seeded derivatives over one period, loop closed by Newton (see class doc)."""
