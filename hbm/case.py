@@ -4,7 +4,8 @@ Schema (``../shared/DESIGN.md``)::
 
     name = "..."
     [model]       mass, stiffness, damping | rayleigh | modal_damping, dof_names   (or file = "x.npz")
-    [[element]]   type = "<registry key>", dofs = ..., law keys
+    [[element]]   type = "<registry key>", dofs = ..., law keys  (elements may add internal
+                  DOFs to the model, e.g. a damper body: see ``_with_internal_dofs``)
     [excitation]  dofs = [...], amplitude = [...]        (cosine at the first harmonic, N)
                   base = { dofs = [...], amplitude = [...] }   (imposed support motion, m)
     [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], max_points, transform,
@@ -27,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import scipy.linalg as sla
 
 from elements import ELEMENTS
 from elements.base import dof_number
@@ -165,7 +167,8 @@ def _model(t, path, base_dir):
         raise CaseError(f"{path}: [model] {exc}") from None
 
 
-def _elements(specs, model, path):
+def _element_specs(specs, path):
+    """``(class, spec with its name, where)`` per ``[[element]]`` table, types checked."""
     if not isinstance(specs, list):
         raise CaseError(f"{path}: [[element]] must be an array of tables")
     out = []
@@ -181,8 +184,44 @@ def _elements(specs, model, path):
             raise CaseError(f"{path}: {where}: unknown element type {typ!r} (known: {', '.join(ELEMENTS)})")
         spec = dict(spec)
         spec.setdefault("name", f"{typ}{i}")
+        out.append((cls, spec, f"{where} ({typ})"))
+    return out
+
+
+def _with_internal_dofs(model, specs, path):
+    """The model with the internal DOFs of the elements appended.
+
+    Hook: an element class may define a classmethod ``internal_dofs(spec, where) ->
+    (names, M_int, K_int)`` (e.g. the body of a wedge damper).  Its DOFs are appended to the
+    linear model in element order, block diagonal, undamped, named as returned
+    (``"<element name>.x"`` ...), so that ``from_spec`` (called afterwards with the augmented
+    size and name map) finds them, and excitation and outputs may name them.
+    """
+    names, Ms, Ks = [], [], []
+    for cls, spec, where in specs:
+        hook = getattr(cls, "internal_dofs", None)
+        if hook is None:
+            continue
         try:
-            out.append(cls.from_spec(spec, model.n_dof, model.dof_index, f"{where} ({typ})"))
+            n, Mi, Ki = hook(spec, where)
+        except ValueError as exc:
+            raise CaseError(f"{path}: {exc}") from None
+        names += list(n)
+        Ms.append(Mi)
+        Ks.append(Ki)
+    if not names:
+        return model
+    try:
+        return model.with_internal_dofs(names, sla.block_diag(*Ms), sla.block_diag(*Ks))
+    except ValueError as exc:
+        raise CaseError(f"{path}: element DOFs: {exc}") from None
+
+
+def _elements(specs, model, path):
+    out = []
+    for cls, spec, where in specs:
+        try:
+            out.append(cls.from_spec(spec, model.n_dof, model.dof_index, where))
         except ValueError as exc:
             raise CaseError(f"{path}: {exc}") from None
     return tuple(out)
@@ -316,7 +355,9 @@ def case_from_dict(data: dict, path: str = "<case>", base_dir: Path | None = Non
         if k not in data:
             raise CaseError(f"{path}: missing table [{k}]")
     model = _model(data["model"], path, base_dir)
-    elements = _elements(data.get("element", []), model, path)
+    specs = _element_specs(data.get("element", []), path)
+    model = _with_internal_dofs(model, specs, path)
+    elements = _elements(specs, model, path)
     excitation = _excitation(data["excitation"], model, path)
     analysis = _analysis(data["analysis"], model, elements, path)
     name = data.get("name", Path(path).stem)

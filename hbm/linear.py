@@ -130,6 +130,30 @@ class LinearModel:
     def dof_index(self) -> dict:
         return self._dof_index
 
+    def with_internal_dofs(self, names, M_add, K_add) -> "LinearModel":
+        """The model with extra DOFs appended (block diagonal, no damping on them).
+
+        Used for the internal unknowns of elements (e.g. a damper body).  When this model has
+        no DOF names, its DOFs are named ``dof0``, ``dof1``, ... so that every DOF has one.
+
+        Parameters
+        ----------
+        names : sequence of str, length m
+            Names of the new DOFs; must not clash with existing names.
+        M_add, K_add : ndarray, shape (m, m)
+            Mass and stiffness (to ground) of the new DOFs.
+        """
+        names = tuple(str(s) for s in names)
+        m = len(names)
+        M_add = _square("internal mass", M_add, m)
+        K_add = _square("internal stiffness", K_add, m)
+        old = self.dof_names or tuple(f"dof{i}" for i in range(self.n_dof))
+        clash = sorted(set(old) & set(names)) or sorted({s for s in names if names.count(s) > 1})
+        if clash:
+            raise ValueError(f"DOF name {clash[0]!r} is used twice")
+        return LinearModel(sla.block_diag(self.M, M_add), sla.block_diag(self.C, np.zeros((m, m))),
+                           sla.block_diag(self.K, K_add), old + names)
+
     def natural_frequencies_hz(self) -> np.ndarray:
         """Undamped natural frequencies in Hz, ascending."""
         lam = sla.eigh(self.K, self.M, eigvals_only=True)

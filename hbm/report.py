@@ -57,6 +57,14 @@ def _jumps(res):
     return {n: predict_jumps(res.freq_hz, o.h1, res.stable, res.folds_hz) for n, o in res.outputs.items()}
 
 
+def _element_entry(e) -> dict:
+    """Name, type and (when the element has one) its static state, e.g. static normal loads."""
+    d = {"name": e.name, "type": type(e).__name__}
+    if hasattr(e, "static_state"):
+        d["static_state"] = e.static_state()
+    return d
+
+
 def summary_dict(case, res, extra=None) -> dict:
     d = {
         "case": case.name,
@@ -75,7 +83,7 @@ def summary_dict(case, res, extra=None) -> dict:
         "n_unstable": None if res.stable is None else int(np.count_nonzero(~res.stable)),
         "jumps": _jumps(res),
         "max_energy_error": float(res.energy_error.max()) if res.energy_error.size else None,
-        "elements": [{"name": e.name, "type": type(e).__name__} for e in case.elements],
+        "elements": [_element_entry(e) for e in case.elements],
         "element_outputs": {n: {"min": float(v.min()), "max": float(v.max())} if v.size else None
                             for n, v in getattr(res, "element_outputs", {}).items()},
     }

@@ -109,6 +109,13 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
     return h, N, lo, hi, tr
 
 
+# Smallest per-DOF unknown scale, relative to the largest.  DOFs that the linear responses
+# leave at rest (by symmetry, e.g. the radial motion of a wedge damper in the in-phase mode)
+# still move through nonlinear effects (mean shifts from normal-load variation); with a floor
+# of 1e-6 the continuation measured those small motions as huge scaled steps and stalled.
+SCALE_FLOOR = 1e-2
+
+
 def _stuck_stiffness(case: Case) -> np.ndarray:
     K = np.zeros((case.n_dof, case.n_dof))
     for e in case.elements:
@@ -117,7 +124,8 @@ def _stuck_stiffness(case: Case) -> np.ndarray:
 
 
 def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
-    """Per-unknown scale: geometric mean of the stuck and free linear peak responses per DOF.
+    """Per-unknown scale: geometric mean of the stuck and free linear peak responses per DOF
+    (the stuck one alone for DOFs that only the elements move).
 
     The linear responses include the supports' imposed motion (base excitation).
     """
@@ -146,7 +154,7 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
     af, ast = amp_free > nil, amp_stuck > nil
     s = np.where(af & ast, np.sqrt(amp_free * amp_stuck), np.where(af, amp_free, amp_stuck))
     smax = s.max() if s.max() > 0 else 1.0
-    s = np.where(af | ast, np.maximum(s, 1e-6 * smax), smax)
+    s = np.where(af | ast, np.maximum(s, SCALE_FLOOR * smax), smax)
     return np.tile(s, problem.basis.n_coef)
 
 
