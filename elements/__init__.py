@@ -8,6 +8,7 @@ from .jenkins import Jenkins
 from .cubic import Cubic
 from .friction3d import Friction3D
 from .coulomb import CoulombStickSlip, CoulombRegularised
+from .brush import Brush
 
 ELEMENTS = {
     "jenkins": Jenkins,
@@ -15,7 +16,8 @@ ELEMENTS = {
     "friction3d": Friction3D,
     "coulomb_stick_slip": CoulombStickSlip,
     "coulomb_regularised": CoulombRegularised,
+    "brush": Brush,
 }
 
 __all__ = ["ELEMENTS", "Element", "Jenkins", "Cubic", "Friction3D", "CoulombStickSlip",
-           "CoulombRegularised"]
+           "CoulombRegularised", "Brush"]

@@ -1,0 +1,90 @@
+r"""Hysteresis loops of an element under an imposed periodic relative motion.
+
+The element is marched over one period of the prescribed coordinates ``z(theta)``
+(``theta = 2 pi j / N``), its loop closed by its own march.  Derived quantities:
+
+- dissipated energy per cycle, the work of the element forces on the imposed motion
+  (trapezoidal rule; the elastic part integrates to zero over a closed loop):
+
+  .. math:: W = \oint f \cdot dz \approx \sum_j \tfrac12 (f_j + f_{j-1}) \cdot (z_j - z_{j-1});
+
+- the describing function of one coordinate moved as ``u = a cos(theta)`` (complex stiffness
+  ``k_eq + i c_eq`` as in the seed's Figs. 19/21): ``k_eq`` the first-harmonic force in phase
+  with the motion over ``a``, and the loss part from the dissipated energy,
+
+  .. math:: k_{eq} = \frac{2}{N a}\sum_j f_j \cos\theta_j, \qquad c_{eq} = \frac{W}{\pi a^2}
+
+  (``c_eq`` in N/m, the imaginary part of the complex stiffness; the viscous-equivalent
+  damping coefficient at angular frequency ``w`` is ``c_eq / w``).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def phase_grid(n_samples: int) -> np.ndarray:
+    """``theta_j = 2 pi j / N``, shape (N,)."""
+    return 2 * np.pi * np.arange(int(n_samples)) / int(n_samples)
+
+
+def harmonic_motion(n_samples: int, amplitude, phase=None, mean=None) -> np.ndarray:
+    """``z_c(theta) = mean_c + a_c sin(theta + phase_c)`` (the seed's ``u = a sin(theta)``).
+
+    Parameters
+    ----------
+    amplitude, phase, mean : array_like, shape (n_local,)
+
+    Returns
+    -------
+    ndarray, shape (N, n_local)
+    """
+    a = np.atleast_1d(np.asarray(amplitude, dtype=float))
+    ph = np.zeros_like(a) if phase is None else np.asarray(phase, dtype=float)
+    m = np.zeros_like(a) if mean is None else np.asarray(mean, dtype=float)
+    th = phase_grid(n_samples)[:, None]
+    return m[None, :] + a[None, :] * np.sin(th + ph[None, :])
+
+
+def loop_forces(element, z) -> np.ndarray:
+    """Forces (N, n_local) of ``element`` over the closed loop of the motion ``z`` (N, n_local)."""
+    z = np.ascontiguousarray(z, dtype=float)
+    f, _ = element.march(z, np.zeros(z.shape + (1,)))
+    return f
+
+
+def dissipated_energy(z, f) -> float:
+    """``W = oint f . dz`` by the trapezoidal rule over the closed period."""
+    z = np.asarray(z, dtype=float)
+    f = np.asarray(f, dtype=float)
+    return float(np.sum(0.5 * (f + np.roll(f, 1, axis=0)) * (z - np.roll(z, 1, axis=0))))
+
+
+def describing_function(element, amplitudes, coordinate: int = 0, n_samples: int = 256, base=None):
+    """Equivalent stiffness and loss stiffness of one coordinate moved as ``a cos(theta)``.
+
+    Parameters
+    ----------
+    element : Element
+    amplitudes : array_like, shape (n_a,)
+        Amplitudes ``a`` of the coordinate.
+    coordinate : int
+        Which local coordinate moves.
+    n_samples : int
+    base : ndarray, shape (N, n_local), optional
+        Motion of the other coordinates (default: at rest).
+
+    Returns
+    -------
+    k_eq, c_eq, energy : ndarray, shape (n_a,)
+    """
+    th = phase_grid(n_samples)
+    k_eq, c_eq, W = [], [], []
+    for a in np.atleast_1d(np.asarray(amplitudes, dtype=float)):
+        z = np.zeros((th.size, element.n_local)) if base is None else np.array(base, dtype=float)
+        z[:, coordinate] += a * np.cos(th)
+        f = loop_forces(element, z)
+        w = dissipated_energy(z, f)
+        k_eq.append(2.0 / (th.size * a) * np.sum(f[:, coordinate] * np.cos(th)))
+        c_eq.append(w / (np.pi * a * a))
+        W.append(w)
+    return np.array(k_eq), np.array(c_eq), np.array(W)
