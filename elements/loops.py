@@ -88,3 +88,70 @@ def describing_function(element, amplitudes, coordinate: int = 0, n_samples: int
         c_eq.append(w / (np.pi * a * a))
         W.append(w)
     return np.array(k_eq), np.array(c_eq), np.array(W)
+
+
+def series_spring_loop(element, k_series: float, u, coordinate: int = 0, tol: float = 1e-11,
+                       max_iter: int = 60):
+    r"""Loop of an element in series with a linear spring under an imposed total motion.
+
+    Solves, at every sample of the period, ``u_e + f(u_e) / k_s = u`` for the element
+    coordinate ``u_e`` (other coordinates at rest) by Newton on the sampled period: the
+    marched forces' seeds with respect to every sample give the exact period Jacobian
+    ``I + (df/du_e) / k_s``.  (The symmetric damper of the seed: each contact in series with
+    half the body, ``k_s = 2 k_w``, relative platform motion ``2 u``.)
+
+    Parameters
+    ----------
+    element : Element
+    k_series : float
+        Spring stiffness, N/m.
+    u : ndarray, shape (N,)
+        Imposed total motion.
+    coordinate : int
+        Element coordinate in series with the spring.
+
+    Returns
+    -------
+    u_e, f : ndarray, shape (N,)
+        Element coordinate and the force through the chain.
+    """
+    u = np.asarray(u, dtype=float)
+    n = u.size
+    z = np.zeros((n, element.n_local))
+    dz = np.zeros((n, element.n_local, n))
+    dz[:, coordinate, :] = np.eye(n)
+    K0 = element.linear_stiffness()[coordinate, coordinate]
+    z[:, coordinate] = u * k_series / (k_series + K0)
+    scale = max(np.abs(u).max(), 1e-300)
+    for _ in range(max_iter):
+        f, df = element.march(z, dz)
+        r = z[:, coordinate] + f[:, coordinate] / k_series - u
+        if np.abs(r).max() <= tol * scale:
+            return z[:, coordinate].copy(), f[:, coordinate].copy()
+        J = np.eye(n) + df[:, coordinate, :] / k_series
+        z[:, coordinate] -= np.linalg.solve(J, r)
+    raise RuntimeError(f"series-spring loop did not converge in {max_iter} Newton steps "
+                       f"(residual {np.abs(r).max() / scale:.2e} of the amplitude)")
+
+
+def symmetric_damper_function(element, k_body: float, amplitudes, n_samples: int = 256):
+    r"""Complex stiffness of a symmetric two-contact damper against relative platform motion.
+
+    Two identical contacts joined by the body stiffness ``k_body`` (massless, quasi-static)
+    between platforms moving ``+-u_rel / 2``: by symmetry the body's midpoint stays put, so
+    each contact is in series with ``2 k_body`` under ``u_rel / 2``, and the force on the
+    platforms is the contact force ``F``.  With ``u_rel = a cos(theta)``:
+    ``k_eq = F_1c / a`` and ``c_eq = W / (pi a^2)``, ``W = oint F du_rel`` (both contacts).
+
+    Returns
+    -------
+    k_eq, c_eq, energy : ndarray, shape (n_a,)
+    """
+    th = phase_grid(n_samples)
+    out = []
+    for a in np.atleast_1d(np.asarray(amplitudes, dtype=float)):
+        u_rel = a * np.cos(th)
+        _, F = series_spring_loop(element, 2.0 * k_body, 0.5 * u_rel)
+        W = dissipated_energy(u_rel[:, None], F[:, None])
+        out.append((2.0 / (n_samples * a) * np.sum(F * np.cos(th)), W / (np.pi * a * a), W))
+    return tuple(np.array(v) for v in zip(*out))

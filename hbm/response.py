@@ -104,7 +104,8 @@ def _stuck_stiffness(case: Case) -> np.ndarray:
 
 
 def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
-    """Per-unknown scale: geometric mean of the stuck and free linear peak responses per DOF.
+    """Per-unknown scale: geometric mean of the stuck and free linear peak responses per DOF
+    (the stuck response alone for DOFs that the free structure does not move).
 
     The linear responses include the supports' imposed motion (base excitation).
     """
@@ -125,6 +126,9 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
             except np.linalg.LinAlgError:
                 continue
             np.maximum(amp, np.abs(x), out=amp)
+    # DOFs moved only through the elements (e.g. a damper body held by its contacts) have no
+    # free response: their stuck response is their scale (the geometric mean would be 0)
+    amp_free = np.where(amp_free > 1e-12 * amp_stuck, amp_free, amp_stuck)
     s = np.sqrt(np.maximum(amp_free, 1e-300) * np.maximum(amp_stuck, 1e-300))
     s = np.maximum(s, 1e-6 * s.max() if s.max() > 0 else 1.0)
     return np.tile(s, problem.basis.n_coef)
