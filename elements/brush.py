@@ -17,11 +17,20 @@ indenter against the plane; ``u_n > 0`` approaches; ``theta_1``, ``theta_2`` rot
 
     u_{n,b} = u_n + \theta_1 y_b - \theta_2 x_b ,
 
-and its tangential motion is ``u_t``: the tangential displacement of the bristle's attachment
-from the rotations, ``theta x (x_b, y_b, h_b)``, is ``theta h_b`` with ``h_b`` of the order of
-the approach (micrometres), second order, and dropped.  A rotation about a point away from
-the contact (a damper rolling about its centre) is a tangential motion of the contact point
-plus this rotation: express it in the element's gather (rigid-offset rows), not here.
+and its tangential motion is that of the contact centre.  The coordinates ``u_t``, ``u_n`` are
+the translation of the indenter's reference point, which lies at the height ``c``
+(``pivot_height``, default 0: the contact centre) above the contact centre on the indenter's
+side; the contact centre then moves tangentially by
+
+.. math::
+
+    u_{t1}^{c} = u_{t1} + c\,\theta_2, \qquad u_{t2}^{c} = u_{t2} - c\,\theta_1
+
+(``theta x r`` with ``r = -c n`` from the pivot), so a rotation about a pivot above the contact
+(rolling with slip) adds tangential slip, and the friction force adds the moment ``c f_t`` about
+the pivot (the element forces are ``T^T f^c`` for ``z^c = T z``).  The bristle's own offset
+from the contact centre adds ``theta (c - h_b)`` instead of ``theta c``: ``h_b`` is of the order
+of the approach (micrometres) against ``c``, and is dropped.
 
 Static state.  The approach ``delta0`` solves ``sum_b kn max(delta0 - h_b, 0) = N0`` (exact
 on the discrete bristles: piecewise quadratic in ``delta0``).  Forces are dynamic forces
@@ -50,7 +59,7 @@ import math
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative
+from .base import Element, coordinate_rows, require_keys, positive, non_negative, finite
 from .hertz import hertz_contact
 
 
@@ -110,18 +119,20 @@ class Brush(Element):
         Half extents of the bristle grid, m.
     nx, ny : int
         Bristles along ``t1`` and ``t2``.
+    pivot_height : float
+        Height ``c`` of the reference point (rotation centre) above the contact centre, m.
     """
 
     velocity = False
     needs_mean = True
     dof_keys = ("t1", "t2", "n", "rx", "ry")
     keys = ("type", "dofs", "mu", "normal_preload", "radius_x", "radius_y", "lx", "ly", "nx", "ny",
-            "kn", "kt", "e_star", "gamma_n", "gamma_t", "name")
+            "kn", "kt", "e_star", "gamma_n", "gamma_t", "pivot_height", "name")
     max_passes = 1000
     closure_tol = 1e-12
 
     def __init__(self, gather, coord_names, kn, kt, mu, normal_preload, radius_x, radius_y, lx, ly,
-                 nx, ny, name="brush"):
+                 nx, ny, pivot_height=0.0, name="brush"):
         names = tuple(coord_names)
         G = np.array(gather, dtype=float, ndmin=2)
         if G.shape[0] != len(names) or "t1" not in names or "n" not in names:
@@ -137,6 +148,7 @@ class Brush(Element):
         self.radius_y = positive("radius_y", radius_y) if not _is_inf(radius_y) else math.inf
         self.lx, self.ly = positive("lx", lx), positive("ly", ly)
         self.nx, self.ny = _count("nx", nx), _count("ny", ny)
+        self.pivot_height = finite("pivot_height", pivot_height)
         super().__init__(G, np.zeros(0), name)
         self.coord_names = names
         self.n_tangential = 2 if "t2" in names else 1
@@ -171,6 +183,15 @@ class Brush(Element):
         self._weight = cnt.astype(float)
         self._pre = self.kn * (self.delta0 - self.h[first])
         self.n_state = 0
+        # contact-centre coordinates z_c = T z (pivot above the contact)
+        T = np.eye(nl)
+        c = self.pivot_height
+        if "ry" in names:
+            T[names.index("t1"), names.index("ry")] = c
+        if "rx" in names and "t2" in names:
+            T[names.index("t2"), names.index("rx")] = -c
+        self._T = T
+        self._shifted = c != 0.0 and not np.array_equal(T, np.eye(nl))
 
     @property
     def n_bristles(self) -> int:
@@ -197,7 +218,7 @@ class Brush(Element):
             raise ValueError(f"{where}: give either kn and kt, or e_star and gamma_t (and gamma_n), not both")
         geo = dict(mu=spec["mu"], normal_preload=spec["normal_preload"], radius_x=spec["radius_x"],
                    radius_y=spec["radius_y"], lx=spec["lx"], ly=spec["ly"], nx=spec["nx"], ny=spec["ny"],
-                   name=spec.get("name", "brush"))
+                   pivot_height=spec.get("pivot_height", 0.0), name=spec.get("name", "brush"))
         if hertz:
             for k in ("e_star", "gamma_t"):
                 if k not in spec:
@@ -228,10 +249,20 @@ class Brush(Element):
     def march_counts(self, z, dz):
         """``march`` plus the bristle counts (open, stuck, marched, worst passes)."""
         from .laws.brush import brush_march
-        z = np.ascontiguousarray(z, dtype=float)
-        return brush_march(self.kt, self.kn, self.mu, self.n_tangential, self._pre, self._weight, self._coef,
-                           z, np.ascontiguousarray(dz, dtype=float), self.start_index(z),
-                           self.max_passes, self.closure_tol)
+        z = np.asarray(z, dtype=float)
+        dz = np.asarray(dz, dtype=float)
+        T = self._T
+        if self._shifted:
+            z = z @ T.T
+            dz = np.einsum("ab,jbp->jap", T, dz)
+        z = np.ascontiguousarray(z)
+        f, df, counts = brush_march(self.kt, self.kn, self.mu, self.n_tangential, self._pre, self._weight,
+                                    self._coef, z, np.ascontiguousarray(dz), self.start_index(z),
+                                    self.max_passes, self.closure_tol)
+        if self._shifted:
+            f = f @ T
+            df = np.einsum("ab,jap->jbp", T, df)
+        return f, df, counts
 
     def linear_stiffness(self):
         """Tangent at rest: statically loaded bristles stuck (``kt`` each) and closed (``kn``)."""
@@ -243,7 +274,7 @@ class Brush(Element):
             K[:nt, :nt] = np.eye(nt) * self.kt * w.sum()
         c = self._coef[loaded]
         K += self.kn * (c * w[:, None]).T @ c
-        return K
+        return self._T.T @ K @ self._T
 
     def static_state(self) -> dict:
         loaded = self.delta0 - self.h > 0

@@ -15,7 +15,11 @@ The element is marched over one period of the prescribed coordinates ``z(theta)`
   .. math:: k_{eq} = \frac{2}{N a}\sum_j f_j \cos\theta_j, \qquad c_{eq} = \frac{W}{\pi a^2}
 
   (``c_eq`` in N/m, the imaginary part of the complex stiffness; the viscous-equivalent
-  damping coefficient at angular frequency ``w`` is ``c_eq / w``).
+  damping coefficient at angular frequency ``w`` is ``c_eq / w``);
+
+- an element in series with a linear spring ``k_s`` under an imposed total motion ``u``
+  (``u_e + f(u_e)/k_s = u`` at every sample, Newton on the sampled period), and from it the
+  complex stiffness of the symmetric two-contact damper of seed 002.
 """
 from __future__ import annotations
 

@@ -43,8 +43,8 @@ from scipy.optimize import brentq
 from .beam import build_beam_model
 
 KEEP = ("ux", "uy", "rx", "ry")
-DEFAULTS = dict(E=210e9, rho=7850.0, nu=0.3, width=0.010, height=0.020, n_elements=12, platform_node=4,
-                m_platform=0.02, m_block=1.0, gap=0.03, m_damper=0.005, k_body=1.0e8, k_string=1.0e3,
+DEFAULTS = dict(E=210e9, rho=7850.0, nu=0.3, width=0.040, height=0.080, n_elements=12, platform_node=6,
+                m_platform=0.1, m_block=1.0, gap=0.03, m_damper=0.005, k_body=1.0e8, k_string=1.0e3,
                 f_oop=544.0, f_ip=536.0, n_cb=6)
 
 
