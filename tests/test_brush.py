@@ -322,3 +322,10 @@ def test_rig_damper_acts_on_out_of_phase_mode():
     m = damped.freq_hz > 560
     f_oop = damped.freq_hz[m][np.argmax(damped.outputs["tips_relative"].h1[m])]
     assert 650 < f_oop < 800, f_oop
+
+
+def test_timesim_rejects_brush_with_one_line():
+    from hbm.case import CaseError
+    from hbm.timesim import pack_elements
+    with pytest.raises(CaseError, match="no time-step law"):
+        pack_elements([rolling_brush()], 5)
