@@ -9,6 +9,7 @@ from .cubic import Cubic
 from .friction3d import Friction3D
 from .coulomb import CoulombStickSlip, CoulombRegularised
 from .wedge import WedgeDamper
+from .brush import Brush
 
 ELEMENTS = {
     "jenkins": Jenkins,
@@ -17,7 +18,8 @@ ELEMENTS = {
     "coulomb_stick_slip": CoulombStickSlip,
     "coulomb_regularised": CoulombRegularised,
     "wedge_damper": WedgeDamper,
+    "brush": Brush,
 }
 
 __all__ = ["ELEMENTS", "Element", "Jenkins", "Cubic", "Friction3D", "CoulombStickSlip",
-           "CoulombRegularised", "WedgeDamper"]
+           "CoulombRegularised", "WedgeDamper", "Brush"]

@@ -570,6 +570,10 @@ class _Packed:
 def pack_elements(elements, n_dof: int) -> _Packed:
     """Flat arrays of the elements for the kernel (kinds, params/states/gathers with offsets)."""
     n_el = len(elements)
+    for e in elements:
+        if e.kind < 0:
+            raise CaseError(f"element {e.name}: {type(e).__name__} has no time-step law; "
+                            f"the time-domain reference does not support it")
     kinds = np.array([e.kind for e in elements], dtype=np.int64)
     p_off = np.zeros(n_el + 1, dtype=np.int64)
     s_off = np.zeros(n_el + 1, dtype=np.int64)
