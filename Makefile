@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 CASE ?= rigs/sdof_jenkins.toml
 
-.PHONY: run test bench setup clean
+.PHONY: run test bench rigs setup clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -23,6 +23,10 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/time_vs_error.py
+
+# every rig's document: figures and tables (each rigs/make_*.py regenerates one rig)
+rigs: $(STAMP)
+	set -e; for f in rigs/make_*.py; do echo "== $$f"; $(BIN)/python $$f; done
 
 clean:
 	rm -rf out .pytest_cache

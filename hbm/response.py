@@ -123,9 +123,20 @@ def _stuck_stiffness(case: Case) -> np.ndarray:
     return K
 
 
+def _stuck_damping(case: Case) -> np.ndarray:
+    """Viscous tangent at rest of velocity-dependent elements (``linear_damping``), (n, n)."""
+    C = np.zeros((case.n_dof, case.n_dof))
+    for e in case.elements:
+        cd = getattr(e, "linear_damping", None)
+        if cd is not None:
+            C += e.gather.T @ cd() @ e.gather
+    return C
+
+
 def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
     """Per-unknown scale: geometric mean of the stuck and free linear peak responses per DOF
-    (the stuck one alone for DOFs that only the elements move).
+    (the stuck one alone where the free system leaves the DOF at rest).  "Stuck" adds every
+    element's tangent at rest: ``linear_stiffness`` and, for velocity laws, ``linear_damping``.
 
     The linear responses include the supports' imposed motion (base excitation).
     """
@@ -135,11 +146,12 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
     amp_free = np.zeros(fr.size)
     amp_stuck = np.zeros(fr.size)
     M, C, K = case.model.M, case.model.C, case.model.K
+    Cs = C + _stuck_damping(case)
     f = case.excitation.force[fr]
     yb = problem.X_fixed[problem.basis.row_of(1, "c"), fx]
     for w in ws:
-        for Kx, amp in ((K, amp_free), (K + Ks, amp_stuck)):
-            Zc = Kx - w * w * M + 1j * w * C
+        for Kx, Cx, amp in ((K, C, amp_free), (K + Ks, Cs, amp_stuck)):
+            Zc = Kx - w * w * M + 1j * w * Cx
             rhs = f - Zc[np.ix_(fr, fx)] @ yb
             try:
                 x = np.linalg.solve(Zc[np.ix_(fr, fr)], rhs)

@@ -1,0 +1,1 @@
+"""Parameter studies of the rigs (scripts with importable functions)."""
