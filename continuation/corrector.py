@@ -34,6 +34,10 @@ is solved with the current :math:`\|J_s\|_\infty` alone), so
 Newton update has fallen to round-off, :math:`\|\delta\|_\infty \le 16\,\epsilon\,(1 +
 \|x_s\|_\infty)`, with the residual already below :math:`\sqrt{tol}\,\rho`.
 
+Non-smooth residuals (a stick-slip switch between two time samples) can make Newton cycle
+between iterates whose residual stays a few times above ``tol``; the best iterate is then
+accepted when its residual is within ``stall_factor * tol`` (default 10).
+
 Polishing: at convergence the Newton matrix at the last evaluation is already at hand, so one
 more update :math:`\delta` is solved and applied without calling the function again; by
 quadratic convergence the returned point is then accurate to about :math:`tol^2`, i.e. to
@@ -128,7 +132,8 @@ def sphere_constraint(center: np.ndarray, radius: float) -> Constraint:
 
 
 def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
-            constraint: Constraint, rho0: float | None, tol: float, max_iter: int, max_backtrack: int) -> Correction:
+            constraint: Constraint, rho0: float | None, tol: float, max_iter: int, max_backtrack: int,
+            stall_factor: float = 10.0) -> Correction:
     """Newton with backtracking on ``[R(s*xs); g(xs)] = 0`` (module doc).
 
     Parameters
@@ -148,6 +153,9 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         Newton updates allowed.
     max_backtrack : int
         Halvings of an update tried when the merit grows.
+    stall_factor : float
+        Without convergence, the best iterate is accepted if its residual is within
+        ``stall_factor * tol`` and it satisfies the constraint (cycling at a kink).
 
     Returns
     -------
@@ -161,12 +169,15 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     n = ev.R.size
     rhs = np.empty(n + 1)
     A = np.empty((n + 1, n + 1))
+    best = (np.inf, ev, 0)
     for it in range(max_iter + 1):
         rho = max(rho0, ev.row_norm())
         res = float(np.abs(ev.R).max(initial=0.0)) / rho
         g, a = constraint(ev.xs)
         size = 1.0 + float(np.abs(ev.xs).max())
         converged = res <= tol and abs(g) <= tol * size
+        if res < best[0] and abs(g) <= tol * size:
+            best = (res, ev, it)
         if it == max_iter and not converged:
             break
         A[:n] = ev.Js
@@ -205,5 +216,7 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         ev = trial
     rho = max(rho0, ev.row_norm())
     res = float(np.abs(ev.R).max(initial=0.0)) / rho
+    if best[0] <= stall_factor * tol:
+        return Correction(True, best[1], best[2], best[0])
     return Correction(False, ev, max_iter, res,
                       f"no convergence in {max_iter} iterations (residual {res:.1e})")
