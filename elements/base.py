@@ -130,7 +130,11 @@ def dof_number(d, n_dof, dof_index, where) -> int:
     if isinstance(d, str):
         if dof_index is None or d not in dof_index:
             raise ValueError(f"{where}: unknown DOF name {d!r}")
-        return int(dof_index[d])
+        v = dof_index[d]
+        if isinstance(v, dict):
+            raise ValueError(f"{where}: {d!r} is a combination of DOFs (a point coordinate), "
+                             "not a single DOF")
+        return int(v)
     if isinstance(d, bool) or not isinstance(d, (int, np.integer)):
         raise ValueError(f"{where}: a DOF must be an index or a name, got {d!r}")
     if not 0 <= d < n_dof:
@@ -138,8 +142,25 @@ def dof_number(d, n_dof, dof_index, where) -> int:
     return int(d)
 
 
+def coordinate(d, n_dof, dof_index, where) -> dict:
+    """A coordinate as ``{dof: coefficient}``: a DOF (index or name) or a named combination.
+
+    A name map value may be a DOF index or a dict ``{dof: coefficient}`` (e.g. the
+    translation of a rigid-offset point, ``u_p = u_n + theta_n x r``).
+    """
+    if isinstance(d, str) and dof_index is not None and isinstance(dof_index.get(d), dict):
+        row = {int(k): float(c) for k, c in dof_index[d].items()}
+        if any(not 0 <= k < n_dof for k in row):
+            raise ValueError(f"{where}: coordinate {d!r} refers to DOFs outside the model")
+        return row
+    return {dof_number(d, n_dof, dof_index, where): 1.0}
+
+
 def coordinate_rows(specs, n_dof, dof_index=None, where="element") -> np.ndarray:
     """Gather matrix rows for coordinates given as ``a``, ``[a]`` or ``[a, b]`` (``q_a - q_b``).
+
+    ``a`` and ``b`` are DOF indices, DOF names or names of DOF combinations (see
+    :func:`coordinate`).
 
     Returns
     -------
@@ -150,11 +171,11 @@ def coordinate_rows(specs, n_dof, dof_index=None, where="element") -> np.ndarray
         items = spec if isinstance(spec, (list, tuple)) else [spec]
         if len(items) not in (1, 2):
             raise ValueError(f"{where}: dofs must be [a] or [a, b], got {spec!r}")
-        a = dof_number(items[0], n_dof, dof_index, where)
-        G[r, a] += 1.0
+        for k, c in coordinate(items[0], n_dof, dof_index, where).items():
+            G[r, k] += c
         if len(items) == 2:
-            b = dof_number(items[1], n_dof, dof_index, where)
-            if b == a:
+            for k, c in coordinate(items[1], n_dof, dof_index, where).items():
+                G[r, k] -= c
+            if not np.any(G[r]):
                 raise ValueError(f"{where}: dofs [a, b] must differ, got {spec!r}")
-            G[r, b] -= 1.0
     return G

@@ -3,7 +3,14 @@
 Schema (``../shared/DESIGN.md``)::
 
     name = "..."
-    [model]       mass, stiffness, damping | rayleigh | modal_damping, dof_names   (or file = "x.npz")
+    [model]       one source:  mass, stiffness [, dof_names]        (inline matrices)
+                           |  file = "x.npz" | "x_K.mtx" | "x.op4"  (hbm.model_io)
+                           |  builder = "beam" with [[model.beam]], [[model.body]],
+                              [[model.spring]] tables (rigs.builders.assembly)
+                  damping:     damping (matrix) | rayleigh = [a, b] | modal_damping = z or [z1, ...]
+                               (a file's C is used unless one of these is given)
+                  solver:      solver = "auto" | "full" | "condensed", modes = 40 | "all",
+                               residual_flexibility = true            (hbm.structure)
     [[element]]   type = "<registry key>", dofs = ..., law keys
     [excitation]  dofs = [...], amplitude = [...]        (cosine at the first harmonic, N)
     [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], outputs = {name = dof},
@@ -23,10 +30,14 @@ from pathlib import Path
 import numpy as np
 
 from elements import ELEMENTS
-from elements.base import dof_number
+from elements.base import coordinate
 
 from .fourier import parse_harmonics, min_samples, default_samples
 from .linear import LinearModel
+from .model_io import load_model_file
+from .structure import Damping, ReductionSettings, Structure
+
+EAGER_CHECK_DOF = 500      # dense models up to this size are fully validated at load time
 
 
 class CaseError(ValueError):
@@ -34,7 +45,10 @@ class CaseError(ValueError):
 
 
 TOP_KEYS = ("name", "model", "element", "excitation", "analysis")
-MODEL_KEYS = ("mass", "stiffness", "damping", "rayleigh", "modal_damping", "dof_names", "file")
+MODEL_KEYS = ("mass", "stiffness", "damping", "rayleigh", "modal_damping", "dof_names", "file",
+              "builder", "beam", "body", "spring", "solver", "modes", "residual_flexibility")
+BUILDER_TABLES = ("beam", "body", "spring")
+BUILDERS = ("beam",)
 EXCITATION_KEYS = ("dofs", "amplitude")
 ANALYSIS_KEYS = ("harmonics", "time_samples", "frequency_hz", "outputs", "max_points", "transform")
 
@@ -48,7 +62,11 @@ class Excitation:
 
 @dataclass(frozen=True)
 class Analysis:
-    """Analysis settings: harmonic list, samples per period, frequency range (Hz), outputs."""
+    """Analysis settings: harmonic list, samples per period, frequency range (Hz), outputs.
+
+    ``outputs`` maps a name to a DOF index, or to ``{dof: coefficient}`` for a combination
+    (a point coordinate such as ``"platform.x"``).
+    """
 
     harmonics: np.ndarray
     time_samples: int
@@ -57,22 +75,43 @@ class Analysis:
     max_points: int = 2000
     transform: str = "auto"
 
+    def output_rows(self, n_dof: int) -> np.ndarray:
+        """Output gather rows ``y = G_o q``, shape (n_outputs, n_dof), in the order of ``outputs``."""
+        G = np.zeros((len(self.outputs), n_dof))
+        for i, d in enumerate(self.outputs.values()):
+            for k, c in (d.items() if isinstance(d, dict) else ((d, 1.0),)):
+                G[i, k] += c
+        return G
+
 
 @dataclass(frozen=True)
 class Case:
-    """A validated, immutable case: linear model, elements, excitation, analysis."""
+    """A validated, immutable case: linear structure, elements, excitation, analysis.
+
+    ``structure`` holds the matrices as given (dense or sparse, :mod:`hbm.structure`);
+    ``model`` is the dense :class:`LinearModel` of the full solver, formed on first use
+    (:class:`CaseError` for models too large for it); ``reduction`` holds the solver keys.
+    """
 
     name: str
     path: str
-    model: LinearModel
+    structure: Structure
     elements: tuple
     excitation: Excitation
     analysis: Analysis
     raw: dict = field(repr=False, compare=False, default_factory=dict)
+    reduction: ReductionSettings = ReductionSettings()
+
+    @property
+    def model(self) -> LinearModel:
+        try:
+            return self.structure.linear_model()
+        except ValueError as exc:
+            raise CaseError(f"{self.path}: [model] {exc}") from None
 
     @property
     def n_dof(self) -> int:
-        return self.model.n_dof
+        return self.structure.n_dof
 
 
 def _check_keys(table, allowed, where, path):
@@ -108,52 +147,115 @@ def _number(value, name, path, *, positive=False, integer=False):
     return value
 
 
+def _damping(t, path, n):
+    given = [k for k in ("damping", "rayleigh", "modal_damping") if k in t]
+    if len(given) > 1:
+        raise CaseError(f"{path}: [model] give only one of damping, rayleigh, modal_damping")
+    if not given:
+        return None
+    k = given[0]
+    v = t[k]
+    if k == "damping":
+        C = _matrix(v, "damping", path)
+        if C.shape != (n, n):
+            raise CaseError(f"{path}: [model] damping must be {n}x{n} like the mass matrix, got {C.shape}")
+        return Damping("matrix", C)
+    if k == "rayleigh":
+        if not (isinstance(v, list) and len(v) == 2):
+            raise CaseError(f"{path}: [model] rayleigh must be a pair [a, b]")
+        return Damping("rayleigh", tuple(_number(x, "[model] rayleigh", path) for x in v))
+    if isinstance(v, list):
+        z = [_number(x, "[model] modal_damping", path) for x in v]
+    else:
+        z = _number(v, "[model] modal_damping", path)
+    if np.any(np.asarray(z) < 0):
+        raise CaseError(f"{path}: [model] modal_damping ratios must be >= 0")
+    return Damping("modal", z)
+
+
+def _reduction_settings(t, path):
+    modes = t.get("modes")
+    if modes == "all":
+        modes = -1
+    elif modes is not None:
+        _number(modes, "[model] modes", path, positive=True, integer=True)
+    rf = t.get("residual_flexibility", True)
+    if not isinstance(rf, bool):
+        raise CaseError(f"{path}: [model] residual_flexibility must be true or false, got {rf!r}")
+    solver = t.get("solver", "auto")
+    try:
+        return ReductionSettings(solver, modes if modes != -1 else None, rf), modes == -1
+    except ValueError as exc:
+        raise CaseError(f"{path}: [model] {exc}") from None
+
+
 def _model(t, path, base_dir):
+    """``[model]`` -> (Structure, ReductionSettings)."""
     _check_keys(t, MODEL_KEYS, "[model]", path)
-    damping = {}
-    for k in ("damping", "rayleigh", "modal_damping"):
-        if k in t:
-            damping[k] = t[k] if k == "modal_damping" else _matrix(t[k], k, path) if k == "damping" else t[k]
+    sources = [k for k in ("file", "builder") if k in t] + (["mass/stiffness"] if "mass" in t or "stiffness" in t else [])
+    if len(sources) != 1:
+        raise CaseError(f"{path}: [model] give exactly one model source: mass/stiffness, file or builder"
+                        + (f" (got {', '.join(sources)})" if sources else ""))
+    if "builder" not in t:
+        for k in BUILDER_TABLES:
+            if k in t:
+                raise CaseError(f"{path}: [model] {k} needs builder = \"beam\"")
+    names = ()
+    points = {}
+    C_file = None
     if "file" in t:
-        f = base_dir / t["file"]
+        f = base_dir / str(t["file"])
         if not f.is_file():
             raise CaseError(f"{path}: [model] file {str(f)!r} not found")
         try:
-            data = np.load(f, allow_pickle=False)
-            M, K = data["M"], data["K"]
-            if "C" in data.files and "damping" not in damping:
-                damping["damping"] = data["C"]
-            names = tuple(str(s) for s in data["dof_names"]) if "dof_names" in data.files else ()
-        except (OSError, KeyError, ValueError) as exc:
-            raise CaseError(f"{path}: cannot read model file {str(f)!r} (need arrays M and K): {exc}") from None
-        if "mass" in t or "stiffness" in t:
-            raise CaseError(f"{path}: [model] give either file or mass/stiffness, not both")
+            data = load_model_file(f)
+        except ValueError as exc:
+            raise CaseError(f"{path}: [model] cannot read model file {str(f)!r}: {exc}") from None
+        M, K, C_file, names = data.M, data.K, data.C, data.dof_names
+        if "dof_names" in t:
+            if names:
+                raise CaseError(f"{path}: [model] dof_names given but the model file names its DOFs")
+            names = tuple(t["dof_names"])
+    elif "builder" in t:
+        if t["builder"] not in BUILDERS:
+            raise CaseError(f"{path}: [model] unknown builder {t['builder']!r} (known: {', '.join(BUILDERS)})")
+        if "dof_names" in t:
+            raise CaseError(f"{path}: [model] dof_names cannot be given with a builder (it names the DOFs)")
+        from rigs.builders.assembly import build_assembly
+        try:
+            a = build_assembly(t.get("beam", []), t.get("body", []), t.get("spring", []))
+        except ValueError as exc:
+            raise CaseError(f"{path}: {exc}") from None
+        M, K, names, points = a.M, a.K, a.dof_names, a.points
     else:
         for k in ("mass", "stiffness"):
             if k not in t:
                 raise CaseError(f"{path}: [model] missing key {k!r}")
         M, K = _matrix(t["mass"], "mass", path), _matrix(t["stiffness"], "stiffness", path)
         names = tuple(t.get("dof_names", ()))
-    if "rayleigh" in damping:
-        r = damping["rayleigh"]
-        if not (isinstance(r, list) and len(r) == 2):
-            raise CaseError(f"{path}: [model] rayleigh must be a pair [a, b]")
-    if "modal_damping" in damping:
-        z = damping["modal_damping"]
-        if isinstance(z, list):
-            [_number(v, "[model] modal_damping", path) for v in z]
-        else:
-            _number(z, "[model] modal_damping", path)
+    damping = _damping(t, path, M.shape[0])
+    if damping is None:
+        damping = Damping("matrix", C_file) if C_file is not None else Damping()
+    settings, all_modes = _reduction_settings(t, path)
     try:
-        return LinearModel.with_damping(M, K, dof_names=names, **damping)
+        st = Structure(M, K, damping, tuple(str(s) for s in names), points)
+        if all_modes:
+            settings = ReductionSettings(settings.solver, st.n_dof, settings.residual_flexibility)
+        if settings.modes is not None and settings.modes > st.n_dof - (1 if st.sparse else 0):
+            raise ValueError(f"modes = {settings.modes} is more than the model's {st.n_dof} DOFs"
+                             + (" allow for a sparse model (at most n - 1)" if st.sparse else ""))
+        if not st.sparse and st.n_dof <= EAGER_CHECK_DOF:
+            st.linear_model()          # full validation (definiteness) while it is cheap
     except ValueError as exc:
         raise CaseError(f"{path}: [model] {exc}") from None
+    return st, settings
 
 
-def _elements(specs, model, path):
+def _elements(specs, model: Structure, path):
     if not isinstance(specs, list):
         raise CaseError(f"{path}: [[element]] must be an array of tables")
     out = []
+    coords = model.coordinates()
     for i, spec in enumerate(specs):
         where = f"[[element]] #{i}"
         if not isinstance(spec, dict):
@@ -167,15 +269,15 @@ def _elements(specs, model, path):
         spec = dict(spec)
         spec.setdefault("name", f"{typ}{i}")
         try:
-            out.append(cls.from_spec(spec, model.n_dof, model.dof_index, f"{where} ({typ})"))
+            out.append(cls.from_spec(spec, model.n_dof, coords, f"{where} ({typ})"))
         except ValueError as exc:
             raise CaseError(f"{path}: {exc}") from None
     return tuple(out)
 
 
-def _dof(d, model, where, path):
+def _coordinate(d, model, coords, where, path) -> dict:
     try:
-        return dof_number(d, model.n_dof, model.dof_index, where)
+        return coordinate(d, model.n_dof, coords, where)
     except ValueError as exc:
         raise CaseError(f"{path}: {exc}") from None
 
@@ -189,8 +291,11 @@ def _excitation(t, model, path):
     if not isinstance(dofs, list) or not isinstance(amp, list) or len(dofs) != len(amp) or not dofs:
         raise CaseError(f"{path}: [excitation] dofs and amplitude must be lists of the same length")
     force = np.zeros(model.n_dof)
+    coords = model.coordinates()
     for d, a in zip(dofs, amp):
-        force[_dof(d, model, "[excitation] dofs", path)] += _number(a, "[excitation] amplitude", path)
+        a = _number(a, "[excitation] amplitude", path)
+        for k, c in _coordinate(d, model, coords, "[excitation] dofs", path).items():
+            force[k] += a * c        # a force along a point coordinate: f = a G_p^T
     if not np.any(force):
         raise CaseError(f"{path}: [excitation] amplitude is zero: nothing to respond to")
     return Excitation(force)
@@ -222,7 +327,12 @@ def _analysis(t, model, elements, path):
     outs = t["outputs"]
     if not isinstance(outs, dict) or not outs:
         raise CaseError(f"{path}: [analysis] outputs must be a table name = dof")
-    outputs = {str(k): _dof(v, model, f"[analysis] outputs.{k}", path) for k, v in outs.items()}
+    coords = model.coordinates()
+    outputs = {}
+    for k, v in outs.items():
+        row = _coordinate(v, model, coords, f"[analysis] outputs.{k}", path)
+        only = next(iter(row.items()))
+        outputs[str(k)] = only[0] if len(row) == 1 and only[1] == 1.0 else row
     mp = _number(t.get("max_points", 2000), "[analysis] max_points", path, positive=True, integer=True)
     tr = t.get("transform", "auto")
     if tr not in ("auto", "dft", "numpy", "fftw"):
@@ -238,14 +348,14 @@ def case_from_dict(data: dict, path: str = "<case>", base_dir: Path | None = Non
     for k in ("model", "excitation", "analysis"):
         if k not in data:
             raise CaseError(f"{path}: missing table [{k}]")
-    model = _model(data["model"], path, base_dir)
-    elements = _elements(data.get("element", []), model, path)
-    excitation = _excitation(data["excitation"], model, path)
-    analysis = _analysis(data["analysis"], model, elements, path)
+    structure, settings = _model(data["model"], path, base_dir)
+    elements = _elements(data.get("element", []), structure, path)
+    excitation = _excitation(data["excitation"], structure, path)
+    analysis = _analysis(data["analysis"], structure, elements, path)
     name = data.get("name", Path(path).stem)
     if not isinstance(name, str):
         raise CaseError(f"{path}: name must be a string")
-    return Case(name, path, model, elements, excitation, analysis, copy.deepcopy(data))
+    return Case(name, path, structure, elements, excitation, analysis, copy.deepcopy(data), settings)
 
 
 def load_case(path) -> Case:

@@ -9,7 +9,9 @@ the work of a periodic force ``F`` on the velocity over one period is (Parseval)
 
 At a converged point the excitation's work equals the viscous plus the friction dissipation,
 :math:`W[F_{ex}] = \frac{T}{2}\sum_r V_r^T C V_r + W[F_{nl}]` (stiffness and mass forces do
-no work over a period).
+no work over a period).  A problem that carries its own balance (the condensed problem of
+:mod:`hbm.condensed`, whose viscous work comes from modal coordinates) provides
+``problem.energy_balance(X, w)``, which :func:`energy_balance` uses.
 """
 from __future__ import annotations
 
@@ -40,6 +42,9 @@ def work(basis, F: np.ndarray, V: np.ndarray, w: float) -> float:
 
 def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
     """Energy balance of ``problem`` (a :class:`hbm.residual.HarmonicBalance`) at ``(X, w)``."""
+    own = getattr(problem, "energy_balance", None)
+    if own is not None:
+        return own(X, w)
     basis = problem.basis
     V = w * (basis.D @ X)
     w_ex = work(basis, problem.Fex, V, w)

@@ -7,6 +7,13 @@ stuck; failing that, from the response without elements; failing that, by rampin
 excitation.  Every converged point is checked by the energy balance (:mod:`hbm.energy`).
 Outputs per point: first-harmonic amplitude ``h1 = sqrt(Xc1^2 + Xs1^2)`` and ``max`` of
 ``|x(t)|`` over a period on a fine grid.
+
+Solver choice (``[model] solver``, :func:`choose_solver`): ``full`` solves for every DOF
+(:class:`hbm.residual.HarmonicBalance`); ``condensed`` solves for the contact coordinates
+only (:class:`hbm.condensed.CondensedHarmonicBalance`, on a reduced model computed once and
+cached next to the case) and recovers the outputs from them at every point; ``auto`` takes
+the condensed solver for sparse models or more than ``AUTO_CONDENSE_DOF`` DOFs.  The result's
+``settings`` say which was used (``solver``, ``modes``, ``reduction_seconds``, ...).
 """
 from __future__ import annotations
 
@@ -18,10 +25,13 @@ import numpy as np
 from continuation import Arclength, ArclengthOptions
 
 from .case import Case, CaseError
+from .condensed import CondensedHarmonicBalance
 from .energy import energy_balance
 from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
 from .newton import newton
+from .reduction_cache import cache_path, reduce_cached
 from .residual import HarmonicBalance
+from .structure import AUTO_CONDENSE_DOF
 from .transforms import make_transform
 
 
@@ -43,7 +53,8 @@ class FRFResult:
         Along the continuation path (folds appear as frequency reversals).
     outputs : dict of str -> OutputSeries
     X : ndarray, shape (n_points, n_coef, n)
-        Harmonic coefficients of every point.
+        Harmonic coefficients of every point's unknowns: all DOFs (full solver) or the
+        contact coordinates (condensed solver).
     stable : ndarray of bool or None
     folds_hz : list of float
     energy_error : ndarray, shape (n_points,)
@@ -66,6 +77,8 @@ class FRFResult:
     n_rejected: int
     solve_seconds: float
     settings: dict = field(default_factory=dict)
+    Y: np.ndarray | None = None
+    """Output coefficients of every point, (n_points, n_coef, n_outputs), in ``outputs`` order."""
 
     @property
     def ok(self) -> bool:
@@ -96,46 +109,122 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
     return h, N, lo, hi, tr
 
 
-def _stuck_stiffness(case: Case) -> np.ndarray:
-    K = np.zeros((case.n_dof, case.n_dof))
-    for e in case.elements:
+def choose_solver(case: Case) -> str:
+    """``full`` or ``condensed`` for ``case`` (``[model] solver``, ``auto`` by size)."""
+    s = case.reduction.solver
+    if s != "auto":
+        return s
+    st = case.structure
+    return "condensed" if st.sparse or st.n_dof > AUTO_CONDENSE_DOF else "full"
+
+
+def build_problem(case: Case, basis: FourierBasis, transform: str):
+    """The harmonic-balance problem of ``case`` on ``basis`` and what was chosen.
+
+    Returns
+    -------
+    problem : HarmonicBalance or CondensedHarmonicBalance
+    info : dict
+        ``solver``, ``n_dof`` (model), ``n_unknowns``, and for the condensed solver ``modes``,
+        ``residual_flexibility``, ``contact_coordinates``, ``reduction_seconds``,
+        ``reduction_cached``.
+    """
+    solver = choose_solver(case)
+    tr = make_transform(basis, transform)
+    st = case.structure
+    info = {"solver": solver, "n_dof": st.n_dof}
+    if solver == "full":
+        problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force, tr)
+        info.update(modes=None, reduction_seconds=0.0)
+    else:
+        G_o = case.analysis.output_rows(st.n_dof)
+        force = case.excitation.force
+        rows = np.vstack([e.gather for e in case.elements] + [force[None, :], G_o])
+        keep = np.flatnonzero(np.any(rows != 0.0, axis=0))
+        modes = case.reduction.modes or st.default_modes()
+        try:
+            cr = reduce_cached(st, keep, modes, case.reduction.residual_flexibility, cache_path(case.path))
+            problem = CondensedHarmonicBalance(cr.reduced, case.elements, basis, force, tr, G_o)
+        except ValueError as exc:
+            raise CaseError(f"{case.path}: [model] condensed solver: {exc}") from exc
+        info.update(modes=int(cr.reduced.n_modes), residual_flexibility=case.reduction.residual_flexibility,
+                    contact_coordinates=int(problem.n_dof),
+                    reduction_seconds=round(cr.seconds, 6), reduction_cached=cr.from_cache)
+    info["n_unknowns"] = int(problem.basis.n_coef * problem.n_dof)
+    return problem, info
+
+
+def _stuck_stiffness(problem) -> np.ndarray:
+    """Stiffness of the elements at rest over the problem's unknowns, (n, n)."""
+    K = np.zeros((problem.n_dof, problem.n_dof))
+    for e in problem.nl.elements:
         K += e.gather.T @ e.linear_stiffness() @ e.gather
     return K
 
 
-def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
-    """Per-DOF amplitude scale: geometric mean of the stuck and free linear peak responses."""
+def _load(problem, w: float) -> np.ndarray:
+    """Excitation in the residual at ``w``: ``F_ex`` (full) or ``F_eq(w)`` (condensed)."""
+    return problem.load(w) if isinstance(problem, CondensedHarmonicBalance) else problem.Fex
+
+
+def recover_outputs(problem, case: Case, X: np.ndarray, w: float) -> np.ndarray:
+    """Output coefficients (n_coef, n_outputs) of a point ``X`` (n_coef, n) at ``w``."""
+    if isinstance(problem, CondensedHarmonicBalance):
+        return problem.recover_outputs(X, w)
+    return X @ case.analysis.output_rows(problem.n_dof).T
+
+
+def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
+    """Per-unknown amplitude scale: geometric mean of the stuck and free linear peak responses."""
     ws = np.linspace(w_lo, w_hi, 41)
-    Ks = _stuck_stiffness(case)
-    amp_free = np.zeros(case.n_dof)
-    amp_stuck = np.zeros(case.n_dof)
-    n = case.n_dof
-    M, C, K, f = case.model.M, case.model.C, case.model.K, case.excitation.force
-    for w in ws:
-        for Kx, amp in ((K, amp_free), (K + Ks, amp_stuck)):
-            Zc = Kx - w * w * M + 1j * w * C
-            try:
-                x = np.linalg.solve(Zc, f)
-            except np.linalg.LinAlgError:
-                continue
-            np.maximum(amp, np.abs(x), out=amp)
+    Ks = _stuck_stiffness(problem)
+    if isinstance(problem, CondensedHarmonicBalance):
+        amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, Ks)
+    else:
+        amp_free = np.zeros(case.n_dof)
+        amp_stuck = np.zeros(case.n_dof)
+        M, C, K, f = case.model.M, case.model.C, case.model.K, case.excitation.force
+        for w in ws:
+            for Kx, amp in ((K, amp_free), (K + Ks, amp_stuck)):
+                Zc = Kx - w * w * M + 1j * w * C
+                try:
+                    x = np.linalg.solve(Zc, f)
+                except np.linalg.LinAlgError:
+                    continue
+                np.maximum(amp, np.abs(x), out=amp)
     s = np.sqrt(np.maximum(amp_free, 1e-300) * np.maximum(amp_stuck, 1e-300))
-    s = np.maximum(s, 1e-6 * s.max() if s.max() > 0 else 1.0)
+    floor = 1e-6
+    if isinstance(problem, CondensedHarmonicBalance):
+        # The condensed unknowns are a few contact coordinates, each under an element.  One
+        # that only the contacts move (free response zero, e.g. the far side of a damper) or
+        # that the linear response leaves still (a contact normal under a tangential force)
+        # must not get a tiny scale: it would dominate the arclength, or its near-zero
+        # Jacobian column would spoil the continuation's tangent.
+        s = np.maximum(s, amp_stuck)
+        floor = 1e-2
+    s = np.maximum(s, floor * s.max() if s.max() > 0 else 1.0)
     return np.tile(s, problem.basis.n_coef)
+
+
+def _r_scale(problem, case: Case, w: float) -> float:
+    if isinstance(problem, CondensedHarmonicBalance):
+        return float(np.linalg.norm(problem.load(w))) or 1.0
+    return float(np.linalg.norm(case.excitation.force))
 
 
 def _first_point(problem, case, w0, scale, r_scale):
     """Converged first point ``X`` (n_coef, n) at ``w0``, or raise RuntimeError with the reason."""
-    fun = lambda X: problem.residual(X.reshape(problem.Fex.shape), w0)[:2]
-    guesses = [problem.linear_solution(w0, _stuck_stiffness(case)), problem.linear_solution(w0)]
+    shape = (problem.basis.n_coef, problem.n_dof)
+    fun = lambda X: problem.residual(X.reshape(shape), w0)[:2]
+    guesses = [problem.linear_solution(w0, _stuck_stiffness(problem)), problem.linear_solution(w0)]
     last = None
     for g in guesses:
         res = newton(fun, g.ravel(), scale=scale, r_scale=r_scale)
         if res.converged:
-            return res.x.reshape(problem.Fex.shape), res.iterations
+            return res.x.reshape(shape), res.iterations
         last = res
     # ramp the excitation from a small fraction
-    Fex = problem.Fex
+    Fex = _load(problem, w0)
     X = guesses[0] * 0.1
     its = 0
     for lam in (0.1, 0.2, 0.35, 0.5, 0.7, 0.85, 1.0):
@@ -178,17 +267,15 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     """
     h, N, lo, hi, tr = resolve_settings(case, harmonics, samples, fmin, fmax, transform)
     basis = FourierBasis(h, N)
-    problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force,
-                              make_transform(basis, tr))
+    problem, info = build_problem(case, basis, tr)
     w_lo, w_hi = 2 * np.pi * lo, 2 * np.pi * hi
     t0 = time.perf_counter()
     xscale = _unknown_scale(problem, case, w_lo, w_hi)
-    r_scale = float(np.linalg.norm(case.excitation.force))
+    r_scale = _r_scale(problem, case, w_lo)
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
-                "transform": problem.nl.transform.name}
-    shape = problem.Fex.shape
-    out_dofs = case.analysis.outputs
-    pts_X, pts_w, its, eerr = [], [], [], []
+                "transform": problem.nl.transform.name, **info}
+    shape = (basis.n_coef, problem.n_dof)
+    pts_X, pts_w, pts_Y, its, eerr = [], [], [], [], []
     status, message, folds, n_rej = "failed", "", [], 0
     try:
         X0, it0 = _first_point(problem, case, w_lo, xscale, r_scale)
@@ -204,6 +291,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             w = float(pt.x[-1])
             pts_X.append(X)
             pts_w.append(w)
+            pts_Y.append(recover_outputs(problem, case, X, w))
             its.append(pt.iterations if pts_w[1:] else it0 + pt.iterations)
             eerr.append(energy_balance(problem, X, w).relative_error)
             if progress is not None:
@@ -218,18 +306,20 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         n_rej = solver.n_rejected
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
+    n_out = len(case.analysis.outputs)
+    Ys = np.array(pts_Y) if pts_Y else np.zeros((0, basis.n_coef, n_out))
     outputs = {}
-    for name, dof in out_dofs.items():
-        xd = Xs[:, :, dof]
-        if 1 in basis.harmonics and Xs.shape[0]:
+    for i, name in enumerate(case.analysis.outputs):
+        yd = Ys[:, :, i]
+        if 1 in basis.harmonics and Ys.shape[0]:
             rc = basis.row_of(1, "c")
-            h1 = np.hypot(xd[:, rc], xd[:, rc + 1])
+            h1 = np.hypot(yd[:, rc], yd[:, rc + 1])
         else:
-            h1 = np.zeros(Xs.shape[0])
-        mx = max_abs(basis, xd.T)
+            h1 = np.zeros(Ys.shape[0])
+        mx = max_abs(basis, yd.T)
         outputs[name] = OutputSeries(h1, mx)
     return FRFResult(np.array(pts_w) / (2 * np.pi), outputs, Xs, basis, None, folds,
-                     np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings)
+                     np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings, Ys)
 
 
 def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform=None):
@@ -238,8 +328,10 @@ def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform
     Returns
     -------
     X : ndarray, shape (n_coef, n)
+        Coefficients of the unknowns (all DOFs, or the contact coordinates of the condensed
+        solver; :func:`recover_outputs` gives the outputs).
     basis : FourierBasis
-    problem : HarmonicBalance
+    problem : HarmonicBalance or CondensedHarmonicBalance
 
     Raises
     ------
@@ -248,11 +340,10 @@ def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform
     """
     h, N, _, _, tr = resolve_settings(case, harmonics, samples, None, None, transform)
     basis = FourierBasis(h, N)
-    problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force,
-                              make_transform(basis, tr))
+    problem, _ = build_problem(case, basis, tr)
     w = 2 * np.pi * float(freq_hz)
     xscale = _unknown_scale(problem, case, w * 0.9, w * 1.1)
-    X, _ = _first_point(problem, case, w, xscale, float(np.linalg.norm(case.excitation.force)))
+    X, _ = _first_point(problem, case, w, xscale, _r_scale(problem, case, w))
     return X, basis, problem
 
 
