@@ -241,9 +241,9 @@ def _model(t, path, base_dir):
         st = Structure(M, K, damping, tuple(str(s) for s in names), points)
         if all_modes:
             settings = ReductionSettings(settings.solver, st.n_dof, settings.residual_flexibility)
-        if settings.modes is not None and settings.modes > st.n_dof - (1 if st.sparse else 0):
-            raise ValueError(f"modes = {settings.modes} is more than the model's {st.n_dof} DOFs"
-                             + (" allow for a sparse model (at most n - 1)" if st.sparse else ""))
+        if settings.modes is not None and settings.modes > st.max_modes:
+            raise ValueError(f"modes = {settings.modes} is more than the {st.max_modes} modes "
+                             f"a model of {st.n_dof} DOFs allows")
         if not st.sparse and st.n_dof <= EAGER_CHECK_DOF:
             st.linear_model()          # full validation (definiteness) while it is cheap
     except ValueError as exc:

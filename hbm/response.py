@@ -175,7 +175,8 @@ def recover_outputs(problem, case: Case, X: np.ndarray, w: float) -> np.ndarray:
 
 
 def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
-    """Per-unknown amplitude scale: geometric mean of the stuck and free linear peak responses."""
+    """Per-unknown amplitude scale: geometric mean of the stuck and free linear peak responses,
+    at least the stuck one and at least 1 % of the largest."""
     ws = np.linspace(w_lo, w_hi, 41)
     Ks = _stuck_stiffness(problem)
     if isinstance(problem, CondensedHarmonicBalance):
@@ -193,16 +194,14 @@ def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
                     continue
                 np.maximum(amp, np.abs(x), out=amp)
     s = np.sqrt(np.maximum(amp_free, 1e-300) * np.maximum(amp_stuck, 1e-300))
-    floor = 1e-6
-    if isinstance(problem, CondensedHarmonicBalance):
-        # The condensed unknowns are a few contact coordinates, each under an element.  One
-        # that only the contacts move (free response zero, e.g. the far side of a damper) or
-        # that the linear response leaves still (a contact normal under a tangential force)
-        # must not get a tiny scale: it would dominate the arclength, or its near-zero
-        # Jacobian column would spoil the continuation's tangent.
-        s = np.maximum(s, amp_stuck)
-        floor = 1e-2
-    s = np.maximum(s, floor * s.max() if s.max() > 0 else 1.0)
+    # An unknown that only the contacts move (free response zero, e.g. the far side of a
+    # damper) gets at least its stuck amplitude, and one the linear response leaves still
+    # (an axial DOF under bending, a contact normal under a tangential force) at least 1 %
+    # of the largest: a tiny scale makes its Jacobian column nearly zero in scaled
+    # variables, and the continuation's tangent then drifts along it (steps that converge
+    # in 0 iterations and do not advance the frequency).
+    s = np.maximum(s, amp_stuck)
+    s = np.maximum(s, 1e-2 * s.max() if s.max() > 0 else 1.0)
     return np.tile(s, problem.basis.n_coef)
 
 

@@ -28,6 +28,7 @@ DAMPING_KINDS = ("none", "matrix", "rayleigh", "modal")
 SOLVERS = ("auto", "full", "condensed")
 AUTO_CONDENSE_DOF = 60       # auto: condensed above this many DOFs (or for sparse models)
 DEFAULT_MODES = 40
+DENSE_EIG_MAX = 1000         # sparse models up to this size are reduced by a dense eigen-solve
 
 
 @dataclass(frozen=True)
@@ -167,17 +168,26 @@ class Structure:
                                                              dof_names=self.dof_names, **kw)
         return self._memo["linear"]
 
+    @property
+    def max_modes(self) -> int:
+        """Most modes a reduction can keep: all, except for large sparse models (n - 1)."""
+        return self.n_dof - 1 if self.sparse and self.n_dof > DENSE_EIG_MAX else self.n_dof
+
     def default_modes(self) -> int:
-        if self.sparse:
-            return min(DEFAULT_MODES, self.n_dof - 1)
-        return min(DEFAULT_MODES, self.n_dof)
+        return min(DEFAULT_MODES, self.max_modes)
 
     def reduce(self, keep_dofs, n_modes: int, residual_flexibility: bool) -> ReducedModel:
-        """:func:`hbm.reduction.reduce_model` with this structure's damping."""
+        """:func:`hbm.reduction.reduce_model` with this structure's damping.
+
+        Sparse models up to ``DENSE_EIG_MAX`` DOFs are reduced densely (all modes allowed);
+        larger ones by the shift-invert Lanczos path.
+        """
         M, K = self.M, self.K
-        if self.sparse and n_modes >= self.n_dof:
-            M, K = (A.toarray() if sp.issparse(A) else A for A in (M, K))
         kw = self.damping.keywords()
+        if self.sparse and self.n_dof <= DENSE_EIG_MAX:
+            M, K = (A.toarray() if sp.issparse(A) else A for A in (M, K))
+            if "damping" in kw and sp.issparse(kw["damping"]):
+                kw = {"damping": kw["damping"].toarray()}
         if self.damping.kind == "modal" and np.ndim(self.damping.value) == 1:
             z = np.asarray(self.damping.value, dtype=float)
             if z.size < n_modes:
