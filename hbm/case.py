@@ -37,7 +37,7 @@ from .linear import LinearModel
 from .model_io import load_model_file
 from .structure import Damping, ReductionSettings, Structure
 
-EAGER_CHECK_DOF = 500      # dense models up to this size are fully validated at load time
+EAGER_CHECK_DOF = 60       # dense models up to this size are fully validated at load time
 
 
 class CaseError(ValueError):

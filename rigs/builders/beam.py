@@ -343,7 +343,8 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
             if key not in pts:
                 raise ValueError(f"point mass names unknown point {key!r}")
             G = _offset_rows(all_names, *pts[key])
-            extra += sp.lil_matrix(mass * (G.T @ G))
+            Gs = sp.csr_matrix(G)                 # 3 rows, 6 non-zeros: keep G^T G sparse
+            extra += sp.lil_matrix(mass * (Gs.T @ Gs))
         else:
             node = int(key)
             if not 0 <= node < n_nodes:
