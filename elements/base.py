@@ -181,7 +181,11 @@ def dof_number(d, n_dof, dof_index, where) -> int:
     if isinstance(d, str):
         if dof_index is None or d not in dof_index:
             raise ValueError(f"{where}: unknown DOF name {d!r}")
-        return int(dof_index[d])
+        v = dof_index[d]
+        if isinstance(v, dict):
+            raise ValueError(f"{where}: {d!r} is a combination of DOFs (a point coordinate), "
+                             "not a single DOF")
+        return int(v)
     if isinstance(d, bool) or not isinstance(d, (int, np.integer)):
         raise ValueError(f"{where}: a DOF must be an index or a name, got {d!r}")
     if not 0 <= d < n_dof:
@@ -193,17 +197,32 @@ def _is_pair(item) -> bool:
     return isinstance(item, (list, tuple))
 
 
+def coordinate(d, n_dof, dof_index, where) -> dict:
+    """A DOF as ``{dof: coefficient}``: an index or a name of the name map.
+
+    A name map value may be a DOF index or a dict ``{dof: coefficient}`` (e.g. the
+    translation of a rigid-offset point, ``u_p = u_n + theta_n x r``).
+    """
+    if isinstance(d, str) and dof_index is not None and isinstance(dof_index.get(d), dict):
+        row = {int(k): float(c) for k, c in dof_index[d].items()}
+        if any(not 0 <= k < n_dof for k in row):
+            raise ValueError(f"{where}: coordinate {d!r} refers to DOFs outside the model")
+        return row
+    return {dof_number(d, n_dof, dof_index, where): 1.0}
+
+
 def coordinate_row(spec, n_dof, dof_index=None, where="element") -> np.ndarray:
     """One gather-matrix row (n_dof,) from a coordinate spec.
 
-    Accepted forms (a DOF is an index or, with a name map, a name):
+    Accepted forms (a DOF is an index or a name of ``dof_index``; a name may stand for a
+    combination, e.g. a point coordinate ``"platform.x"``):
 
     - ``a`` or ``[a]``: ``u = q_a``;
     - ``[a, b]``: ``u = q_a - q_b``;
-    - ``[[a, ca], [b, cb], ...]``: ``u = ca q_a + cb q_b + ...`` (pairs of DOF and
-      coefficient, for directions that are not along the model axes, e.g. an inclined
-      contact ``t1 = [[0, 0.866], [1, 0.5]]``); each DOF at most once, coefficients finite
-      and not all zero.
+    - ``[[a, ca], [b, cb], ...]`` or ``{a = ca, b = cb}``: ``u = ca q_a + cb q_b + ...``
+      (directions that are not along the model axes, e.g. an inclined contact
+      ``t1 = [[0, 0.866], [1, 0.5]]``); each DOF at most once, coefficients finite and not
+      all zero.
 
     Raises
     ------
@@ -211,19 +230,29 @@ def coordinate_row(spec, n_dof, dof_index=None, where="element") -> np.ndarray:
         A malformed spec, with ``where`` and the spec in the message.
     """
     row = np.zeros(n_dof)
-    items = spec if isinstance(spec, (list, tuple)) else [spec]
+    if isinstance(spec, dict):
+        items = [[k, v] for k, v in spec.items()]
+        if not items:
+            raise ValueError(f"{where}: an empty coordinate table {spec!r}")
+    else:
+        items = spec if isinstance(spec, (list, tuple)) else [spec]
     if items and all(_is_pair(it) for it in items):
         seen = set()
         for it in items:
             if len(it) != 2:
                 raise ValueError(f"{where}: a weighted coordinate is a list of [dof, coefficient] pairs, "
                                  f"got {it!r} in {spec!r}")
-            a = dof_number(it[0], n_dof, dof_index, where)
+            d = it[0]
+            if isinstance(spec, dict) and isinstance(d, str) and d.isdigit() and \
+                    (dof_index is None or d not in dof_index):
+                d = int(d)                       # TOML table keys are strings: "0" is DOF 0
             c = _number(f"{where}: coefficient of DOF {it[0]!r}", it[1])
-            if a in seen:
+            key = d if isinstance(d, str) else dof_number(d, n_dof, dof_index, where)
+            if key in seen:
                 raise ValueError(f"{where}: DOF {it[0]!r} appears twice in {spec!r}")
-            seen.add(a)
-            row[a] = c
+            seen.add(key)
+            for k, ck in coordinate(d, n_dof, dof_index, where).items():
+                row[k] += c * ck
         if not np.any(row):
             raise ValueError(f"{where}: all coefficients are zero in {spec!r}")
         return row
@@ -232,13 +261,13 @@ def coordinate_row(spec, n_dof, dof_index=None, where="element") -> np.ndarray:
                          f"(use a, [a, b] or [[a, ca], [b, cb], ...])")
     if len(items) not in (1, 2):
         raise ValueError(f"{where}: dofs must be a, [a], [a, b] or [[a, ca], [b, cb], ...], got {spec!r}")
-    a = dof_number(items[0], n_dof, dof_index, where)
-    row[a] += 1.0
+    for k, c in coordinate(items[0], n_dof, dof_index, where).items():
+        row[k] += c
     if len(items) == 2:
-        b = dof_number(items[1], n_dof, dof_index, where)
-        if b == a:
+        for k, c in coordinate(items[1], n_dof, dof_index, where).items():
+            row[k] -= c
+        if not np.any(row):
             raise ValueError(f"{where}: dofs [a, b] must differ, got {spec!r}")
-        row[b] -= 1.0
     return row
 
 
@@ -247,6 +276,9 @@ def coordinate_rows(specs, n_dof, dof_index=None, where="element") -> np.ndarray
     or ``[[a, ca], [b, cb], ...]`` (``ca q_a + cb q_b + ...``); see :func:`coordinate_row`.
 
     ``where`` may be a string (used for every row) or a sequence with one label per row.
+
+    ``a`` and ``b`` are DOF indices, DOF names or names of DOF combinations (see
+    :func:`coordinate`).
 
     Returns
     -------

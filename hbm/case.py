@@ -3,7 +3,14 @@
 Schema (``../shared/DESIGN.md``)::
 
     name = "..."
-    [model]       mass, stiffness, damping | rayleigh | modal_damping, dof_names   (or file = "x.npz")
+    [model]       one source:  mass, stiffness [, dof_names]        (inline matrices)
+                           |  file = "x.npz" | "x_K.mtx" | "x.op4"  (hbm.model_io)
+                           |  builder = "beam" with [[model.beam]], [[model.body]],
+                              [[model.spring]] tables (rigs.builders.assembly)
+                  damping:     damping (matrix) | rayleigh = [a, b] | modal_damping = z or [z1, ...]
+                               (a file's C is used unless one of these is given)
+                  solver:      solver = "auto" | "full" | "condensed", modes = 40 | "all",
+                               residual_flexibility = true            (hbm.structure)
     [[element]]   type = "<registry key>", dofs = ..., law keys  (elements may add internal
                   DOFs to the model, e.g. a damper body: see ``_with_internal_dofs``)
     [excitation]  dofs = [...], amplitude = [...]        (cosine at the first harmonic, N)
@@ -11,10 +18,12 @@ Schema (``../shared/DESIGN.md``)::
     [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], max_points, transform,
                   outputs = {name = dof, name = [a, b], name = "ELEMENT.QUANTITY"}
 
-An output is a DOF (index or name), ``[a, b]`` for the relative motion ``q_a - q_b`` (both:
-first-harmonic amplitude and max over a period), or a per-period quantity of a named element,
-``"contact.normal_load_min"`` (the element's ``name`` key, then one of its class's
-``quantities``); a string that is a DOF name is a DOF.
+A DOF is an index or a name (model DOF names, builder names such as ``n3.ux``, point
+coordinates such as ``"blade1.platform.x"``, element DOFs such as ``"upd.x"``).  An output is
+a DOF, ``[a, b]`` for the relative motion ``q_a - q_b``, a weighted combination
+``[[a, ca], [b, cb], ...]`` (all: first-harmonic amplitude and max over a period), or a
+per-period quantity of a named element, ``"contact.normal_load_min"`` (the element's ``name``
+key, then one of its class's ``quantities``); a string that is a DOF name is a DOF.
 
 Every unknown key is an error naming the key and the file.  Errors are :class:`CaseError`
 (a ``ValueError``) with a one-line message.
@@ -31,10 +40,14 @@ import numpy as np
 import scipy.linalg as sla
 
 from elements import ELEMENTS
-from elements.base import dof_number
+from elements.base import coordinate_row
 
 from .fourier import parse_harmonics, min_samples, default_samples
 from .linear import LinearModel
+from .model_io import load_model_file
+from .structure import Damping, ReductionSettings, Structure
+
+EAGER_CHECK_DOF = 60       # dense models up to this size are fully validated at load time
 
 
 class CaseError(ValueError):
@@ -42,7 +55,10 @@ class CaseError(ValueError):
 
 
 TOP_KEYS = ("name", "model", "element", "excitation", "analysis")
-MODEL_KEYS = ("mass", "stiffness", "damping", "rayleigh", "modal_damping", "dof_names", "file")
+MODEL_KEYS = ("mass", "stiffness", "damping", "rayleigh", "modal_damping", "dof_names", "file",
+              "builder", "beam", "body", "spring", "solver", "modes", "residual_flexibility")
+BUILDER_TABLES = ("beam", "body", "spring")
+BUILDERS = ("beam",)
 EXCITATION_KEYS = ("dofs", "amplitude", "base")
 BASE_KEYS = ("dofs", "amplitude")
 ANALYSIS_KEYS = ("harmonics", "time_samples", "frequency_hz", "outputs", "max_points", "transform")
@@ -61,9 +77,9 @@ class Excitation:
 class Analysis:
     """Analysis settings: harmonic list, samples per period, frequency range (Hz), outputs.
 
-    ``outputs`` maps output names to gather rows (n,) (a DOF, or ``q_a - q_b``);
-    ``element_outputs`` maps output names to ``(element index, quantity)`` for the outputs
-    written ``"ELEMENT.QUANTITY"``.
+    ``outputs`` maps output names to gather rows (n,) (``y = g . q``: a DOF, ``q_a - q_b``, a
+    point coordinate or a weighted combination); ``element_outputs`` maps output names to
+    ``(element index, quantity)`` for the outputs written ``"ELEMENT.QUANTITY"``.
     """
 
     harmonics: np.ndarray
@@ -72,24 +88,44 @@ class Analysis:
     outputs: dict
     max_points: int = 2000
     transform: str = "auto"
-    element_outputs: dict = field(default_factory=dict)   # name -> (element index, quantity)
+    element_outputs: dict = field(default_factory=dict)
+
+    def output_rows(self, n_dof: int) -> np.ndarray:
+        """Output gather rows ``y = G_o q``, shape (n_outputs, n_dof), in the order of ``outputs``."""
+        G = np.zeros((len(self.outputs), n_dof))
+        for i, g in enumerate(self.outputs.values()):
+            G[i] = g
+        return G
 
 
 @dataclass(frozen=True)
 class Case:
-    """A validated, immutable case: linear model, elements, excitation, analysis."""
+    """A validated, immutable case: linear structure, elements, excitation, analysis.
+
+    ``structure`` holds the matrices as given (dense or sparse, :mod:`hbm.structure`);
+    ``model`` is the dense :class:`LinearModel` of the full solver, formed on first use
+    (:class:`CaseError` for models too large for it); ``reduction`` holds the solver keys.
+    """
 
     name: str
     path: str
-    model: LinearModel
+    structure: Structure
     elements: tuple
     excitation: Excitation
     analysis: Analysis
     raw: dict = field(repr=False, compare=False, default_factory=dict)
+    reduction: ReductionSettings = ReductionSettings()
+
+    @property
+    def model(self) -> LinearModel:
+        try:
+            return self.structure.linear_model()
+        except ValueError as exc:
+            raise CaseError(f"{self.path}: [model] {exc}") from None
 
     @property
     def n_dof(self) -> int:
-        return self.model.n_dof
+        return self.structure.n_dof
 
 
 def _check_keys(table, allowed, where, path):
@@ -125,46 +161,108 @@ def _number(value, name, path, *, positive=False, integer=False):
     return value
 
 
+def _damping(t, path, n):
+    given = [k for k in ("damping", "rayleigh", "modal_damping") if k in t]
+    if len(given) > 1:
+        raise CaseError(f"{path}: [model] give only one of damping, rayleigh, modal_damping")
+    if not given:
+        return None
+    k = given[0]
+    v = t[k]
+    if k == "damping":
+        C = _matrix(v, "damping", path)
+        if C.shape != (n, n):
+            raise CaseError(f"{path}: [model] damping must be {n}x{n} like the mass matrix, got {C.shape}")
+        return Damping("matrix", C)
+    if k == "rayleigh":
+        if not (isinstance(v, list) and len(v) == 2):
+            raise CaseError(f"{path}: [model] rayleigh must be a pair [a, b]")
+        return Damping("rayleigh", tuple(_number(x, "[model] rayleigh", path) for x in v))
+    if isinstance(v, list):
+        z = [_number(x, "[model] modal_damping", path) for x in v]
+    else:
+        z = _number(v, "[model] modal_damping", path)
+    if np.any(np.asarray(z) < 0):
+        raise CaseError(f"{path}: [model] modal_damping ratios must be >= 0")
+    return Damping("modal", z)
+
+
+def _reduction_settings(t, path):
+    modes = t.get("modes")
+    if modes == "all":
+        modes = -1
+    elif modes is not None:
+        _number(modes, "[model] modes", path, positive=True, integer=True)
+    rf = t.get("residual_flexibility", True)
+    if not isinstance(rf, bool):
+        raise CaseError(f"{path}: [model] residual_flexibility must be true or false, got {rf!r}")
+    solver = t.get("solver", "auto")
+    try:
+        return ReductionSettings(solver, modes if modes != -1 else None, rf), modes == -1
+    except ValueError as exc:
+        raise CaseError(f"{path}: [model] {exc}") from None
+
+
 def _model(t, path, base_dir):
+    """``[model]`` -> (Structure, ReductionSettings)."""
     _check_keys(t, MODEL_KEYS, "[model]", path)
-    damping = {}
-    for k in ("damping", "rayleigh", "modal_damping"):
-        if k in t:
-            damping[k] = t[k] if k == "modal_damping" else _matrix(t[k], k, path) if k == "damping" else t[k]
+    sources = [k for k in ("file", "builder") if k in t] + (["mass/stiffness"] if "mass" in t or "stiffness" in t else [])
+    if len(sources) != 1:
+        raise CaseError(f"{path}: [model] give exactly one model source: mass/stiffness, file or builder"
+                        + (f" (got {', '.join(sources)})" if sources else ""))
+    if "builder" not in t:
+        for k in BUILDER_TABLES:
+            if k in t:
+                raise CaseError(f"{path}: [model] {k} needs builder = \"beam\"")
+    names = ()
+    points = {}
+    C_file = None
     if "file" in t:
-        f = base_dir / t["file"]
+        f = base_dir / str(t["file"])
         if not f.is_file():
             raise CaseError(f"{path}: [model] file {str(f)!r} not found")
         try:
-            data = np.load(f, allow_pickle=False)
-            M, K = data["M"], data["K"]
-            if "C" in data.files and "damping" not in damping:
-                damping["damping"] = data["C"]
-            names = tuple(str(s) for s in data["dof_names"]) if "dof_names" in data.files else ()
-        except (OSError, KeyError, ValueError) as exc:
-            raise CaseError(f"{path}: cannot read model file {str(f)!r} (need arrays M and K): {exc}") from None
-        if "mass" in t or "stiffness" in t:
-            raise CaseError(f"{path}: [model] give either file or mass/stiffness, not both")
+            data = load_model_file(f)
+        except ValueError as exc:
+            raise CaseError(f"{path}: [model] cannot read model file {str(f)!r}: {exc}") from None
+        M, K, C_file, names = data.M, data.K, data.C, data.dof_names
+        if "dof_names" in t:
+            if names:
+                raise CaseError(f"{path}: [model] dof_names given but the model file names its DOFs")
+            names = tuple(t["dof_names"])
+    elif "builder" in t:
+        if t["builder"] not in BUILDERS:
+            raise CaseError(f"{path}: [model] unknown builder {t['builder']!r} (known: {', '.join(BUILDERS)})")
+        if "dof_names" in t:
+            raise CaseError(f"{path}: [model] dof_names cannot be given with a builder (it names the DOFs)")
+        from rigs.builders.assembly import build_assembly
+        try:
+            a = build_assembly(t.get("beam", []), t.get("body", []), t.get("spring", []))
+        except ValueError as exc:
+            raise CaseError(f"{path}: {exc}") from None
+        M, K, names, points = a.M, a.K, a.dof_names, a.points
     else:
         for k in ("mass", "stiffness"):
             if k not in t:
                 raise CaseError(f"{path}: [model] missing key {k!r}")
         M, K = _matrix(t["mass"], "mass", path), _matrix(t["stiffness"], "stiffness", path)
         names = tuple(t.get("dof_names", ()))
-    if "rayleigh" in damping:
-        r = damping["rayleigh"]
-        if not (isinstance(r, list) and len(r) == 2):
-            raise CaseError(f"{path}: [model] rayleigh must be a pair [a, b]")
-    if "modal_damping" in damping:
-        z = damping["modal_damping"]
-        if isinstance(z, list):
-            [_number(v, "[model] modal_damping", path) for v in z]
-        else:
-            _number(z, "[model] modal_damping", path)
+    damping = _damping(t, path, M.shape[0])
+    if damping is None:
+        damping = Damping("matrix", C_file) if C_file is not None else Damping()
+    settings, all_modes = _reduction_settings(t, path)
     try:
-        return LinearModel.with_damping(M, K, dof_names=names, **damping)
+        st = Structure(M, K, damping, tuple(str(s) for s in names), points)
+        if all_modes:
+            settings = ReductionSettings(settings.solver, st.n_dof, settings.residual_flexibility)
+        if settings.modes is not None and settings.modes > st.max_modes:
+            raise ValueError(f"modes = {settings.modes} is more than the {st.max_modes} modes "
+                             f"a model of {st.n_dof} DOFs allows")
+        if not st.sparse and st.n_dof <= EAGER_CHECK_DOF:
+            st.linear_model()          # full validation (definiteness) while it is cheap
     except ValueError as exc:
         raise CaseError(f"{path}: [model] {exc}") from None
+    return st, settings
 
 
 def _element_specs(specs, path):
@@ -188,14 +286,14 @@ def _element_specs(specs, path):
     return out
 
 
-def _with_internal_dofs(model, specs, path):
-    """The model with the internal DOFs of the elements appended.
+def _with_internal_dofs(structure: Structure, specs, path) -> Structure:
+    """The structure with the internal DOFs of the elements appended.
 
     Hook: an element class may define a classmethod ``internal_dofs(spec, where) ->
-    (names, M_int, K_int)`` (e.g. the body of a wedge damper).  Its DOFs are appended to the
-    linear model in element order, block diagonal, undamped, named as returned
-    (``"<element name>.x"`` ...), so that ``from_spec`` (called afterwards with the augmented
-    size and name map) finds them, and excitation and outputs may name them.
+    (names, M_int, K_int)`` (e.g. the body of a wedge damper).  Its DOFs are appended in
+    element order, block diagonal, undamped, named as returned (``"<element name>.x"`` ...),
+    so that ``from_spec`` (called afterwards with the augmented size and name map) finds
+    them, and excitation and outputs may name them.
     """
     names, Ms, Ks = [], [], []
     for cls, spec, where in specs:
@@ -210,53 +308,52 @@ def _with_internal_dofs(model, specs, path):
         Ms.append(Mi)
         Ks.append(Ki)
     if not names:
-        return model
+        return structure
     try:
-        return model.with_internal_dofs(names, sla.block_diag(*Ms), sla.block_diag(*Ks))
+        return structure.with_internal_dofs(names, sla.block_diag(*Ms), sla.block_diag(*Ks))
     except ValueError as exc:
         raise CaseError(f"{path}: element DOFs: {exc}") from None
 
 
-def _elements(specs, model, path):
+def _elements(specs, structure: Structure, path):
+    coords = structure.coordinates()
     out = []
     for cls, spec, where in specs:
         try:
-            out.append(cls.from_spec(spec, model.n_dof, model.dof_index, where))
+            out.append(cls.from_spec(spec, structure.n_dof, coords, where))
         except ValueError as exc:
             raise CaseError(f"{path}: {exc}") from None
     return tuple(out)
 
 
-def _dof(d, model, where, path):
-    try:
-        return dof_number(d, model.n_dof, model.dof_index, where)
-    except ValueError as exc:
-        raise CaseError(f"{path}: {exc}") from None
-
-
-def _dof_amplitudes(t, model, where, path):
+def _force_rows(t, model, coords, where, path):
+    """``(rows (k, n), amplitudes (k,))`` of a ``dofs`` / ``amplitude`` pair of lists."""
     for k in ("dofs", "amplitude"):
         if k not in t:
             raise CaseError(f"{path}: {where} missing key {k!r}")
     dofs, amp = t["dofs"], t["amplitude"]
     if not isinstance(dofs, list) or not isinstance(amp, list) or len(dofs) != len(amp) or not dofs:
         raise CaseError(f"{path}: {where} dofs and amplitude must be lists of the same length")
-    idx = [_dof(d, model, f"{where} dofs", path) for d in dofs]
-    if len(set(idx)) != len(idx):
-        raise CaseError(f"{path}: {where} dofs repeats a DOF")
-    return np.array(idx, dtype=int), np.array([_number(a, f"{where} amplitude", path) for a in amp])
+    rows = np.array([_row(d, model, coords, f"{where} dofs", path) for d in dofs])
+    return rows, np.array([_number(a, f"{where} amplitude", path) for a in amp])
 
 
 def _excitation(t, model, path):
     _check_keys(t, EXCITATION_KEYS, "[excitation]", path)
+    coords = model.coordinates()
     force = np.zeros(model.n_dof)
     if "dofs" in t or "amplitude" in t or "base" not in t:
-        idx, amp = _dof_amplitudes(t, model, "[excitation]", path)
-        force[idx] = amp
+        rows, amp = _force_rows(t, model, coords, "[excitation]", path)
+        force = amp @ rows            # a force along a coordinate g: f = a g
     base = None
     if "base" in t:
         _check_keys(t["base"], BASE_KEYS, "[excitation] base", path)
-        bd, ba = _dof_amplitudes(t["base"], model, "[excitation] base", path)
+        rows, ba = _force_rows(t["base"], model, coords, "[excitation] base", path)
+        if np.any(np.count_nonzero(rows, axis=1) != 1) or np.any(rows[rows != 0] != 1.0):
+            raise CaseError(f"{path}: [excitation] base dofs must be single DOFs (the supports)")
+        bd = np.argmax(rows != 0, axis=1)
+        if len(set(bd.tolist())) != bd.size:
+            raise CaseError(f"{path}: [excitation] base dofs repeats a DOF")
         if bd.size == model.n_dof:
             raise CaseError(f"{path}: [excitation] base: every DOF is a support: nothing is free")
         if np.any(force[bd]):
@@ -267,21 +364,30 @@ def _excitation(t, model, path):
     return Excitation(force, base)
 
 
-def _output_row(name, v, model, path):
-    """Gather row (n,) of an output: a DOF (index or name) or [a, b] for q_a - q_b."""
-    where = f"[analysis] outputs.{name}"
-    g = np.zeros(model.n_dof)
-    if isinstance(v, list):
-        if len(v) != 2:
-            raise CaseError(f"{path}: {where} must be a DOF or [a, b] (q_a - q_b), got {v!r}")
-        a, b = (_dof(d, model, where, path) for d in v)
-        if a == b:
-            raise CaseError(f"{path}: {where}: [a, b] must name two different DOFs")
-        g[a], g[b] = 1.0, -1.0
-    else:
-        g[_dof(v, model, where, path)] = 1.0
-    g.setflags(write=False)
-    return g
+def _row(spec, model, coords, where, path) -> np.ndarray:
+    """Gather row (n,) of a coordinate spec (:func:`elements.base.coordinate_row`)."""
+    try:
+        return coordinate_row(spec, model.n_dof, coords, where)
+    except ValueError as exc:
+        raise CaseError(f"{path}: {exc}") from None
+
+
+def _element_output(key, value, elements, path):
+    """``(element index, quantity)`` of an output written ``"ELEMENT.QUANTITY"``."""
+    where = f"{path}: [analysis] outputs.{key}"
+    ename, _, qty = value.rpartition(".")
+    hits = [i for i, e in enumerate(elements) if e.name == ename]
+    if not hits:
+        known = ", ".join(repr(e.name) for e in elements) or "none"
+        raise CaseError(f"{where}: {value!r} names no DOF and no element {ename!r} (elements: {known})")
+    if len(hits) > 1:
+        raise CaseError(f"{where}: element name {ename!r} is not unique; give the elements distinct names")
+    e = elements[hits[0]]
+    if qty not in e.quantities:
+        has = ", ".join(e.quantities) or "none"
+        raise CaseError(f"{where}: element {ename!r} ({type(e).__name__}) has no output {qty!r} "
+                        f"(its outputs: {has})")
+    return hits[0], qty
 
 
 def _analysis(t, model, elements, path):
@@ -310,12 +416,15 @@ def _analysis(t, model, elements, path):
     outs = t["outputs"]
     if not isinstance(outs, dict) or not outs:
         raise CaseError(f"{path}: [analysis] outputs must be a table name = dof")
+    coords = model.coordinates()
     outputs, element_outputs = {}, {}
     for k, v in outs.items():
-        if isinstance(v, str) and v not in model.dof_index and "." in v:
+        if isinstance(v, str) and v not in coords and "." in v:
             element_outputs[str(k)] = _element_output(k, v, elements, path)
         else:
-            outputs[str(k)] = _output_row(k, v, model, path)
+            g = _row(v, model, coords, f"[analysis] outputs.{k}", path)
+            g.setflags(write=False)
+            outputs[str(k)] = g
     columns = [f"{k}_{c}" for k in outputs for c in ("h1", "max")] + list(element_outputs)
     for c in columns:
         if columns.count(c) > 1 or c in ("freq_hz", "stable"):
@@ -328,24 +437,6 @@ def _analysis(t, model, elements, path):
     return Analysis(h, int(N), (float(lo), float(hi)), outputs, int(mp), tr, element_outputs)
 
 
-def _element_output(key, value, elements, path):
-    """``(element index, quantity)`` of an output written ``"ELEMENT.QUANTITY"``."""
-    where = f"{path}: [analysis] outputs.{key}"
-    ename, _, qty = value.rpartition(".")
-    hits = [i for i, e in enumerate(elements) if e.name == ename]
-    if not hits:
-        known = ", ".join(repr(e.name) for e in elements) or "none"
-        raise CaseError(f"{where}: {value!r} names no DOF and no element {ename!r} (elements: {known})")
-    if len(hits) > 1:
-        raise CaseError(f"{where}: element name {ename!r} is not unique; give the elements distinct names")
-    e = elements[hits[0]]
-    if qty not in e.quantities:
-        has = ", ".join(e.quantities) or "none"
-        raise CaseError(f"{where}: element {ename!r} ({type(e).__name__}) has no output {qty!r} "
-                        f"(its outputs: {has})")
-    return hits[0], qty
-
-
 def case_from_dict(data: dict, path: str = "<case>", base_dir: Path | None = None) -> Case:
     """Validate a parsed case table and build the :class:`Case`."""
     path = str(path)
@@ -354,16 +445,16 @@ def case_from_dict(data: dict, path: str = "<case>", base_dir: Path | None = Non
     for k in ("model", "excitation", "analysis"):
         if k not in data:
             raise CaseError(f"{path}: missing table [{k}]")
-    model = _model(data["model"], path, base_dir)
+    structure, settings = _model(data["model"], path, base_dir)
     specs = _element_specs(data.get("element", []), path)
-    model = _with_internal_dofs(model, specs, path)
-    elements = _elements(specs, model, path)
-    excitation = _excitation(data["excitation"], model, path)
-    analysis = _analysis(data["analysis"], model, elements, path)
+    structure = _with_internal_dofs(structure, specs, path)
+    elements = _elements(specs, structure, path)
+    excitation = _excitation(data["excitation"], structure, path)
+    analysis = _analysis(data["analysis"], structure, elements, path)
     name = data.get("name", Path(path).stem)
     if not isinstance(name, str):
         raise CaseError(f"{path}: name must be a string")
-    return Case(name, path, model, elements, excitation, analysis, copy.deepcopy(data))
+    return Case(name, path, structure, elements, excitation, analysis, copy.deepcopy(data), settings)
 
 
 def load_case(path) -> Case:

@@ -101,6 +101,11 @@ def cmd_frf(args) -> int:
     summary = write_frf(case, res, args.out)
     print(f"{case.name}: {summary['n_points']} points, {summary['newton_iterations']} Newton iterations, "
           f"{summary['solve_seconds']:.3f} s, H={res.settings['harmonics'][-1]}, N={res.settings['time_samples']}")
+    st = res.settings
+    if st.get("solver") == "condensed":
+        print(f"  condensed solver: {st['n_dof']} DOFs -> {st['contact_coordinates']} contact coordinates, "
+              f"{st['modes']} modes, reduction {st['reduction_seconds']:.3f} s"
+              + (" (cached)" if st.get("reduction_cached") else ""))
     for name, pk in summary["peaks"].items():
         for p in pk:
             print(f"  peak {name}: {p['amplitude']:.6g} at {p['freq_hz']:.6g} Hz")

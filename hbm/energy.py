@@ -11,6 +11,9 @@ At a converged point the excitation's work equals the viscous plus the friction 
 :math:`W[F_{ex}] = \frac{T}{2}\sum_r V_r^T C V_r + W[F_{nl}]` (stiffness and mass forces do
 no work over a period).  Supports with imposed motion (base excitation) add the work of
 the force that drives them, ``W[R_b]`` on their velocities, to the input.
+A problem that carries its own balance (the condensed problem of
+:mod:`hbm.condensed`, whose viscous work comes from modal coordinates) provides
+``problem.energy_balance(X, w)``, which :func:`energy_balance` uses.
 """
 from __future__ import annotations
 
@@ -41,6 +44,9 @@ def work(basis, F: np.ndarray, V: np.ndarray, w: float) -> float:
 
 def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
     """Energy balance of ``problem`` (a :class:`hbm.residual.HarmonicBalance`) at ``(X, w)``."""
+    own = getattr(problem, "energy_balance", None)
+    if own is not None:
+        return own(X, w)
     basis = problem.basis
     V = w * (basis.D @ X)
     w_ex = work(basis, problem.Fex, V, w)

@@ -19,13 +19,16 @@ import numpy as np
 from continuation import Arclength, ArclengthOptions
 
 from .case import Case, CaseError
+from .condensed import CondensedHarmonicBalance
 from .element_outputs import element_output_series
 from .energy import energy_balance
 from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
 from .jumps import predict_jumps
 from .newton import newton
+from .reduction_cache import cache_path, reduce_cached
 from .residual import HarmonicBalance
 from .stability import StabilityOptions, point_stability
+from .structure import AUTO_CONDENSE_DOF
 from .transforms import make_transform
 
 
@@ -47,7 +50,8 @@ class FRFResult:
         Along the continuation path (folds appear as frequency reversals).
     outputs : dict of str -> OutputSeries
     X : ndarray, shape (n_points, n_coef, n)
-        Harmonic coefficients of every point.
+        Harmonic coefficients of every point's unknowns: all DOFs (full solver, supports
+        included) or the contact coordinates (condensed solver).
     stable : ndarray of bool, shape (n_points,), or None
         Hill stability of every point (``None`` when not computed).
     folds_hz : list of float
@@ -79,6 +83,8 @@ class FRFResult:
     settings: dict = field(default_factory=dict)
     jumps: dict | None = None
     element_outputs: dict = field(default_factory=dict)
+    Y: np.ndarray | None = None
+    """Output coefficients of every point, (n_points, n_coef, n_outputs), in ``outputs`` order."""
 
     @property
     def ok(self) -> bool:
@@ -116,17 +122,86 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
 SCALE_FLOOR = 1e-2
 
 
-def _stuck_stiffness(case: Case) -> np.ndarray:
-    K = np.zeros((case.n_dof, case.n_dof))
-    for e in case.elements:
+# Smallest per-DOF unknown scale, relative to the largest.  DOFs that the linear responses
+# leave at rest (by symmetry, e.g. the radial motion of a wedge damper in the in-phase mode)
+# still move through nonlinear effects (mean shifts from normal-load variation); with a floor
+# of 1e-6 the continuation measured those small motions as huge scaled steps and stalled.
+SCALE_FLOOR = 1e-2
+
+
+def choose_solver(case: Case) -> str:
+    """``full`` or ``condensed`` for ``case`` (``[model] solver``, ``auto`` by size)."""
+    s = case.reduction.solver
+    if s != "auto":
+        return s
+    st = case.structure
+    return "condensed" if st.sparse or st.n_dof > AUTO_CONDENSE_DOF else "full"
+
+
+def build_problem(case: Case, basis: FourierBasis, transform: str):
+    """The harmonic-balance problem of ``case`` on ``basis`` and what was chosen.
+
+    Returns
+    -------
+    problem : HarmonicBalance or CondensedHarmonicBalance
+    info : dict
+        ``solver``, ``n_dof`` (model), ``n_unknowns``, and for the condensed solver ``modes``,
+        ``residual_flexibility``, ``contact_coordinates``, ``reduction_seconds``,
+        ``reduction_cached``.
+    """
+    solver = choose_solver(case)
+    tr = make_transform(basis, transform)
+    st = case.structure
+    info = {"solver": solver, "n_dof": st.n_dof}
+    if solver == "full":
+        problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force, tr,
+                                  base=case.excitation.base)
+        info.update(modes=None, reduction_seconds=0.0)
+    elif case.excitation.base is not None:
+        raise CaseError(f"{case.path}: [excitation] base (support motion) needs the full solver: "
+                        f"set [model] solver = \"full\"")
+    else:
+        G_o = case.analysis.output_rows(st.n_dof)
+        force = case.excitation.force
+        rows = np.vstack([e.gather for e in case.elements] + [force[None, :], G_o])
+        keep = np.flatnonzero(np.any(rows != 0.0, axis=0))
+        modes = case.reduction.modes or st.default_modes()
+        try:
+            cr = reduce_cached(st, keep, modes, case.reduction.residual_flexibility, cache_path(case.path))
+            problem = CondensedHarmonicBalance(cr.reduced, case.elements, basis, force, tr, G_o)
+        except ValueError as exc:
+            raise CaseError(f"{case.path}: [model] condensed solver: {exc}") from exc
+        info.update(modes=int(cr.reduced.n_modes), residual_flexibility=case.reduction.residual_flexibility,
+                    contact_coordinates=int(problem.n_dof),
+                    reduction_seconds=round(cr.seconds, 6), reduction_cached=cr.from_cache)
+    info["n_unknowns"] = int(problem.basis.n_coef * problem.n_dof)
+    return problem, info
+
+
+def _stuck_stiffness(problem) -> np.ndarray:
+    """Stiffness of the elements at rest over the problem's unknowns, (n, n)."""
+    K = np.zeros((problem.n_dof, problem.n_dof))
+    for e in problem.nl.elements:
         K += e.gather.T @ e.linear_stiffness() @ e.gather
     return K
 
 
-def _stuck_damping(case: Case) -> np.ndarray:
+def _load(problem, w: float) -> np.ndarray:
+    """Excitation in the residual at ``w``: ``F_ex`` (full) or ``F_eq(w)`` (condensed)."""
+    return problem.load(w) if isinstance(problem, CondensedHarmonicBalance) else problem.Fex
+
+
+def recover_outputs(problem, case: Case, X: np.ndarray, w: float) -> np.ndarray:
+    """Output coefficients (n_coef, n_outputs) of a point ``X`` (n_coef, n) at ``w``."""
+    if isinstance(problem, CondensedHarmonicBalance):
+        return problem.recover_outputs(X, w)
+    return X @ case.analysis.output_rows(problem.n_dof).T
+
+
+def _stuck_damping(problem) -> np.ndarray:
     """Viscous tangent at rest of velocity-dependent elements (``linear_damping``), (n, n)."""
-    C = np.zeros((case.n_dof, case.n_dof))
-    for e in case.elements:
+    C = np.zeros((problem.n_dof, problem.n_dof))
+    for e in problem.nl.elements:
         cd = getattr(e, "linear_damping", None)
         if cd is not None:
             C += e.gather.T @ cd() @ e.gather
@@ -141,23 +216,26 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
     The linear responses include the supports' imposed motion (base excitation).
     """
     ws = np.linspace(w_lo, w_hi, 41)
-    Ks = _stuck_stiffness(case)
-    fr, fx = problem.free, problem.fixed
-    amp_free = np.zeros(fr.size)
-    amp_stuck = np.zeros(fr.size)
-    M, C, K = case.model.M, case.model.C, case.model.K
-    Cs = C + _stuck_damping(case)
-    f = case.excitation.force[fr]
-    yb = problem.X_fixed[problem.basis.row_of(1, "c"), fx]
-    for w in ws:
-        for Kx, Cx, amp in ((K, C, amp_free), (K + Ks, Cs, amp_stuck)):
-            Zc = Kx - w * w * M + 1j * w * Cx
-            rhs = f - Zc[np.ix_(fr, fx)] @ yb
-            try:
-                x = np.linalg.solve(Zc[np.ix_(fr, fr)], rhs)
-            except np.linalg.LinAlgError:
-                continue
-            np.maximum(amp, np.abs(x), out=amp)
+    Ks = _stuck_stiffness(problem)
+    if isinstance(problem, CondensedHarmonicBalance):
+        amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, Ks)
+    else:
+        fr, fx = problem.free, problem.fixed
+        amp_free = np.zeros(fr.size)
+        amp_stuck = np.zeros(fr.size)
+        M, C, K = case.model.M, case.model.C, case.model.K
+        Cs = C + _stuck_damping(problem)
+        f = case.excitation.force[fr]
+        yb = problem.X_fixed[problem.basis.row_of(1, "c"), fx]
+        for w in ws:
+            for Kx, Cx, amp in ((K, C, amp_free), (K + Ks, Cs, amp_stuck)):
+                Zc = Kx - w * w * M + 1j * w * Cx
+                rhs = f - Zc[np.ix_(fr, fx)] @ yb
+                try:
+                    x = np.linalg.solve(Zc[np.ix_(fr, fr)], rhs)
+                except np.linalg.LinAlgError:
+                    continue
+                np.maximum(amp, np.abs(x), out=amp)
     # a DOF that only the elements couple to the force (free response nil) takes its stuck
     # amplitude, and one without any linear response (round-off) the largest scale: a
     # geometric mean with nil or the 1e-6 floor inflates it in the arclength (the path creeps)
@@ -178,7 +256,7 @@ def _first_point(problem, case, w0, scale, r_scale):
     to ``lam = 1``.
     """
     fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
-    guesses = [problem.linear_solution(w0, _stuck_stiffness(case)), problem.linear_solution(w0)]
+    guesses = [problem.linear_solution(w0, _stuck_stiffness(problem)), problem.linear_solution(w0)]
     last = None
     for g in guesses:
         res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale)
@@ -206,13 +284,6 @@ def _residual_scale(problem, w) -> float:
     """Typical force of the problem: the norm of the residual at zero unknowns (the load)."""
     R = problem.residual(problem.expand(np.zeros(problem.n_unknowns)), w)[0]
     return float(max(np.linalg.norm(R), 1e-300))
-
-
-def build_problem(case: Case, basis: FourierBasis, transform: str) -> HarmonicBalance:
-    """The harmonic-balance residual of ``case`` on ``basis``."""
-    ex = case.excitation
-    return HarmonicBalance(case.model, case.elements, basis, ex.force, make_transform(basis, transform),
-                           base=ex.base)
 
 
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
@@ -247,16 +318,17 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     """
     h, N, lo, hi, tr = resolve_settings(case, harmonics, samples, fmin, fmax, transform)
     basis = FourierBasis(h, N)
-    problem = build_problem(case, basis, tr)
+    problem, info = build_problem(case, basis, tr)
+    # Hill's method needs M and C: not available on the condensed (receptance) problem
+    stability = bool(stability) and isinstance(problem, HarmonicBalance)
     w_lo, w_hi = 2 * np.pi * lo, 2 * np.pi * hi
     t0 = time.perf_counter()
     xscale = _unknown_scale(problem, case, w_lo, w_hi)
     r_scale = _residual_scale(problem, w_lo)
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
-                "transform": problem.nl.transform.name, "stability": bool(stability)}
-    shape = problem.Fex.shape
-    out_dofs = case.analysis.outputs
-    pts_X, pts_w, its, eerr = [], [], [], []
+                "transform": problem.nl.transform.name, "stability": stability, **info}
+    shape = (basis.n_coef, problem.n_dof)
+    pts_X, pts_w, pts_Y, its, eerr = [], [], [], [], []
     status, message, folds, n_rej = "failed", "", [], 0
     try:
         X0, it0 = _first_point(problem, case, w_lo, xscale, r_scale)
@@ -272,6 +344,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             w = float(pt.x[-1])
             pts_X.append(X)
             pts_w.append(w)
+            pts_Y.append(recover_outputs(problem, case, X, w))
             its.append(pt.iterations if pts_w[1:] else it0 + pt.iterations)
             eerr.append(energy_balance(problem, X, w).relative_error)
             if progress is not None:
@@ -290,30 +363,34 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
                            for X, w in zip(pts_X, pts_w)], dtype=bool)
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
+    n_out = len(case.analysis.outputs)
+    Ys = np.array(pts_Y) if pts_Y else np.zeros((0, basis.n_coef, n_out))
     outputs = {}
-    for name, g in out_dofs.items():
-        xd = Xs @ g
-        if 1 in basis.harmonics and Xs.shape[0]:
+    for i, name in enumerate(case.analysis.outputs):
+        yd = Ys[:, :, i]
+        if 1 in basis.harmonics and Ys.shape[0]:
             rc = basis.row_of(1, "c")
-            h1 = np.hypot(xd[:, rc], xd[:, rc + 1])
+            h1 = np.hypot(yd[:, rc], yd[:, rc + 1])
         else:
-            h1 = np.zeros(Xs.shape[0])
-        mx = max_abs(basis, xd.T)
+            h1 = np.zeros(Ys.shape[0])
+        mx = max_abs(basis, yd.T)
         outputs[name] = OutputSeries(h1, mx)
     freq_hz = np.array(pts_w) / (2 * np.pi)
     jumps = None
     if stable is not None:
         land = _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
         jumps = {}
-        for name, g in out_dofs.items():
-            def refine(i0, i1, f, g=g):
+        for i, name in enumerate(case.analysis.outputs):
+            def refine(i0, i1, f, i=i):
                 X = land(i0, i1, f)
-                return None if X is None else output_amplitudes(basis, X @ g)[0]
+                if X is None:
+                    return None
+                return output_amplitudes(basis, recover_outputs(problem, case, X, 2 * np.pi * f)[:, i])[0]
             jumps[name] = predict_jumps(freq_hz, outputs[name].h1, stable, folds, refine=refine)
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
-                     jumps, eouts)
+                     jumps, eouts, Ys)
 
 
 def _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
@@ -359,7 +436,7 @@ def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform
     """
     h, N, _, _, tr = resolve_settings(case, harmonics, samples, None, None, transform)
     basis = FourierBasis(h, N)
-    problem = build_problem(case, basis, tr)
+    problem, _ = build_problem(case, basis, tr)
     w = 2 * np.pi * float(freq_hz)
     xscale = _unknown_scale(problem, case, w * 0.9, w * 1.1)
     X, _ = _first_point(problem, case, w, xscale, _residual_scale(problem, w))

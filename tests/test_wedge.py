@@ -193,7 +193,7 @@ def grid_solutions(case, freqs, X0=None):
     b = FourierBasis(case.analysis.harmonics, case.analysis.time_samples)
     p = HarmonicBalance(case.model, case.elements, b, case.excitation.force, make_transform(b, "auto"))
     sc = _unknown_scale(p, case, 2 * np.pi * freqs.min(), 2 * np.pi * freqs.max())
-    Ks = _stuck_stiffness(case)
+    Ks = _stuck_stiffness(p)
     fs = float(np.linalg.norm(case.excitation.force))
     X, out = X0, []
     for f in freqs:

@@ -241,7 +241,7 @@ def _offset_rows(dof_names, node, offset):
 def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, Iz=None, J=None,
                      width=None, height=None, clamp=(0,), lumped_mass=False, axis=(1.0, 0.0, 0.0),
                      up=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0), points=None, point_masses=None,
-                     sparse=None) -> BeamModel:
+                     sparse=None, allow_free=False) -> BeamModel:
     """Straight 3D beam of ``n_elements`` equal frame elements, nodes ``0..n_elements``.
 
     Parameters
@@ -256,7 +256,8 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
         Section properties (m^2, m^4); or give ``width`` and ``height`` of a solid rectangle
         (``width`` along local y, ``height`` along local z).
     clamp : sequence of int
-        Nodes whose 6 DOFs are fixed (removed).  At least one node (K must be non-singular).
+        Nodes whose 6 DOFs are fixed (removed).  At least one node (K must be non-singular),
+        unless ``allow_free`` (a part of an assembly held by springs).
     lumped_mass : bool
         HRZ lumped mass instead of consistent.
     axis, up, origin : 3-vectors
@@ -267,6 +268,8 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
         ``{node: mass}`` (on the node's translations) or ``{point_name: mass}`` (at the point).
     sparse : bool, optional
         Force sparse (True) or dense (False) output; default by ``DENSE_MAX_DOF``.
+    allow_free : bool
+        Accept ``clamp = []`` (the caller holds the beam otherwise).
 
     Returns
     -------
@@ -299,9 +302,9 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
     coords = np.asarray(origin, dtype=float) + np.outer(np.linspace(0, length, n_nodes), ax)
 
     clamp = sorted(set(int(c) for c in clamp))
-    if not clamp:
+    if not clamp and not allow_free:
         raise ValueError("clamp at least one node (free-free beams are not supported)")
-    if clamp[0] < 0 or clamp[-1] >= n_nodes:
+    if clamp and (clamp[0] < 0 or clamp[-1] >= n_nodes):
         raise ValueError(f"clamp nodes must be in 0..{n_nodes - 1}, got {clamp}")
 
     R = local_axes(coords[0], coords[1], up)
@@ -340,7 +343,8 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
             if key not in pts:
                 raise ValueError(f"point mass names unknown point {key!r}")
             G = _offset_rows(all_names, *pts[key])
-            extra += sp.lil_matrix(mass * (G.T @ G))
+            Gs = sp.csr_matrix(G)                 # 3 rows, 6 non-zeros: keep G^T G sparse
+            extra += sp.lil_matrix(mass * (Gs.T @ Gs))
         else:
             node = int(key)
             if not 0 <= node < n_nodes:
