@@ -17,6 +17,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -115,7 +116,11 @@ def _model(t, path, base_dir):
         if k in t:
             damping[k] = t[k] if k == "modal_damping" else _matrix(t[k], k, path) if k == "damping" else t[k]
     if "file" in t:
+        if not isinstance(t["file"], str):
+            raise CaseError(f"{path}: [model] file must be a path (string), got {t['file']!r}")
         f = base_dir / t["file"]
+        if "mass" in t or "stiffness" in t:
+            raise CaseError(f"{path}: [model] give either file ({t['file']}) or mass/stiffness, not both")
         if not f.is_file():
             raise CaseError(f"{path}: [model] file {str(f)!r} not found")
         try:
@@ -124,16 +129,21 @@ def _model(t, path, base_dir):
             if "C" in data.files and "damping" not in damping:
                 damping["damping"] = data["C"]
             names = tuple(str(s) for s in data["dof_names"]) if "dof_names" in data.files else ()
-        except (OSError, KeyError, ValueError) as exc:
-            raise CaseError(f"{path}: cannot read model file {str(f)!r} (need arrays M and K): {exc}") from None
-        if "mass" in t or "stiffness" in t:
-            raise CaseError(f"{path}: [model] give either file or mass/stiffness, not both")
+        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+            msg = " ".join(str(exc).split())
+            raise CaseError(f"{path}: cannot read model file {str(f)!r} (need arrays M and K): {msg}") from None
     else:
         for k in ("mass", "stiffness"):
             if k not in t:
                 raise CaseError(f"{path}: [model] missing key {k!r}")
         M, K = _matrix(t["mass"], "mass", path), _matrix(t["stiffness"], "stiffness", path)
-        names = tuple(t.get("dof_names", ()))
+        names = t.get("dof_names", [])
+        if not (isinstance(names, list) and all(isinstance(x, str) for x in names)):
+            raise CaseError(f"{path}: [model] dof_names must be a list of strings, got {names!r}")
+        dup = sorted({x for x in names if names.count(x) > 1})
+        if dup:
+            raise CaseError(f"{path}: [model] dof_names repeats {dup[0]!r}")
+        names = tuple(names)
     if "rayleigh" in damping:
         r = damping["rayleigh"]
         if not (isinstance(r, list) and len(r) == 2):
@@ -161,6 +171,8 @@ def _elements(specs, model, path):
         typ = spec.get("type")
         if typ is None:
             raise CaseError(f"{path}: {where}: missing key 'type'")
+        if not isinstance(typ, str):
+            raise CaseError(f"{path}: {where}: type must be a string (known: {', '.join(ELEMENTS)}), got {typ!r}")
         cls = ELEMENTS.get(typ)
         if cls is None:
             raise CaseError(f"{path}: {where}: unknown element type {typ!r} (known: {', '.join(ELEMENTS)})")
@@ -169,7 +181,10 @@ def _elements(specs, model, path):
         try:
             out.append(cls.from_spec(spec, model.n_dof, model.dof_index, f"{where} ({typ})"))
         except ValueError as exc:
-            raise CaseError(f"{path}: {exc}") from None
+            msg = str(exc)
+            if not msg.startswith(where):       # a law parameter check: say which element
+                msg = f"{where} ({typ}): {msg}"
+            raise CaseError(f"{path}: {msg}") from None
     return tuple(out)
 
 
@@ -202,8 +217,11 @@ def _analysis(t, model, elements, path):
         if k not in t:
             raise CaseError(f"{path}: [analysis] missing key {k!r}")
     needs_mean = any(e.needs_mean for e in elements)
+    hs = t.get("harmonics", 5)
+    if isinstance(hs, bool) or not isinstance(hs, (int, list)):
+        raise CaseError(f"{path}: [analysis] harmonics must be an integer H or a list of integers, got {hs!r}")
     try:
-        h = parse_harmonics(t.get("harmonics", 5), include_zero=needs_mean)
+        h = parse_harmonics(hs, include_zero=needs_mean)
     except ValueError as exc:
         raise CaseError(f"{path}: [analysis] {exc}") from None
     if 1 not in h:

@@ -169,7 +169,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
-        parser.print_help(sys.stderr)
+        sys.stderr.write(f"hbm: error: missing command ({', '.join(COMMANDS)}); see hbm --help\n")
         return 2
     try:
         return COMMANDS[args.command](args)

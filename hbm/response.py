@@ -80,8 +80,10 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
     else:
         try:
             h = parse_harmonics(harmonics, include_zero=any(e.needs_mean for e in case.elements))
-        except ValueError as exc:
+        except (ValueError, TypeError) as exc:
             raise CaseError(f"--harmonics: {exc}") from None
+        if 1 not in h:
+            raise CaseError(f"--harmonics must include 1 (the excitation's harmonic), got {list(map(int, h))}")
     if samples is None:
         N = a.time_samples if harmonics is None else max(a.time_samples, default_samples(h))
     else:
