@@ -367,7 +367,7 @@ def write_plot(path: Path, rows: list, outputs: list, xlabel: str, log: bool) ->
 
 # ---------------------------------------------------------------------------- driver
 
-def _executor(options: SweepOptions):
+def _executor(options: SweepOptions, n_tasks: int):
     """``(submit, completed, close)`` over a Dask client or a local process pool."""
     if options.dask:
         try:
@@ -381,7 +381,7 @@ def _executor(options: SweepOptions):
             raise CaseError(f"--dask: cannot connect to scheduler {options.dask!r}: {exc}") from None
         return (lambda t: client.submit(run_task, t, pure=False), dask_completed,
                 lambda: client.close())
-    pool = ProcessPoolExecutor(max_workers=options.jobs or os.cpu_count() or 1)
+    pool = ProcessPoolExecutor(max_workers=max(1, min(options.jobs or os.cpu_count() or 1, n_tasks)))
     return (lambda t: pool.submit(run_task, t), as_completed,
             lambda: pool.shutdown(wait=True, cancel_futures=True))
 
@@ -443,7 +443,7 @@ def sweep(case, key: str, values, outdir=None, *, ratio_key: str | None = None,
         for t in todo:
             record(t, run_task(t))
     elif todo:
-        submit, completed, close = _executor(options)
+        submit, completed, close = _executor(options, len(todo))
         try:
             futures = {submit(t): t for t in todo}
             for fut in completed(list(futures)):
