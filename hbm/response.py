@@ -153,6 +153,27 @@ def _first_point(problem, case, w0, scale, r_scale):
     return X, its
 
 
+POLISH_ENERGY = 1e-10
+
+
+def _polish(problem, X, w, xscale, r_scale, err):
+    """Newton at fixed ``w`` on a point whose energy balance is not closed.
+
+    The continuation's tolerance is relative to the Jacobian's row norm, which a stiff
+    contact (kt >> k) makes large against the excitation: such a point can be accepted with
+    ``|R| / |F|`` ~ 1e-9 and an energy error ~ 1e-6.  Here the target is relative to ``|F|``.
+    Returns the better of the two points and its relative energy error.
+    """
+    fun = lambda x: problem.residual(x.reshape(X.shape), w)[:2]
+    res = newton(fun, X.ravel(), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4)
+    if np.all(np.isfinite(res.x)):
+        Xp = res.x.reshape(X.shape)
+        err_p = energy_balance(problem, Xp, w).relative_error
+        if err_p < err:
+            return Xp, err_p
+    return X, err
+
+
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
         progress=None, options: ArclengthOptions | None = None) -> FRFResult:
     """Trace the FRF of ``case``.
@@ -204,15 +225,23 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         for pt in solver:
             X = pt.x[:-1].reshape(shape)
             w = float(pt.x[-1])
+            err = energy_balance(problem, X, w).relative_error
+            if err > POLISH_ENERGY:
+                X, err = _polish(problem, X, w, xscale, r_scale, err)
             pts_X.append(X)
             pts_w.append(w)
             its.append(pt.iterations if pts_w[1:] else it0 + pt.iterations)
-            eerr.append(energy_balance(problem, X, w).relative_error)
+            eerr.append(err)
             if progress is not None:
                 progress(len(pts_w), w / (2 * np.pi))
             if len(pts_w) >= case.analysis.max_points:
                 break
         status, message = solver.status, solver.message
+        if status == "finished" and pts_w and pts_w[-1] < w_hi * (1 - 1e-9):
+            # the arclength solver also ends on the lower bound: the path turned back
+            status = "failed"
+            message = (f"the path returned to {pts_w[-1] / (2 * np.pi):.6g} Hz after {len(pts_w)} points "
+                       f"without reaching {hi:.6g} Hz ({message})")
         if len(pts_w) >= case.analysis.max_points and status not in ("finished", "failed"):
             status = "max_steps"
             message = f"stopped after max_points={case.analysis.max_points} points at {pts_w[-1] / (2 * np.pi):.6g} Hz"

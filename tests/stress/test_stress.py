@@ -44,6 +44,8 @@ QUICK = [
     cases.jenkins_sdof(1e5, 0.01, 1e-3, 5),         # stays stuck: must equal the linear response
     cases.jenkins_sdof(1.0, 1.0, 1e2, 1),           # H = 1, stiff contact, gross slip
     cases.jenkins_sdof(10.0, 0.1, 1.0, 25),         # H = 25
+    cases.jenkins_sdof(10.0, 0.1, 1e4, 25),         # stiff contact: points need polishing to close the energy
+    cases.jenkins_chain3(1e2, 0.01, 1e4, 1),        # the path turned back to fmin: must be a stated failure
     cases.jenkins_chain3(10.0, 0.1, 1.0, 3),
     cases.friction3d_2dof(10.0, 1.0, 3, False),     # contact stays closed
     cases.friction3d_2dof(10.0, 1.0, 3, True),      # contact separates
