@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 CASE ?= rigs/sdof_jenkins.toml
 
-.PHONY: run test bench rigs setup clean
+.PHONY: run test stress bench rigs setup clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -20,6 +20,10 @@ run: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest tests
+
+# the full stress matrix (minutes; STRESS_JOBS=n worker processes, default: all cores)
+stress: $(STAMP)
+	$(BIN)/python -m pytest tests/stress -m stress
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/time_vs_error.py

@@ -33,6 +33,8 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
+import zipfile
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -208,8 +210,9 @@ def _model(t, path, base_dir):
     _check_keys(t, MODEL_KEYS, "[model]", path)
     sources = [k for k in ("file", "builder") if k in t] + (["mass/stiffness"] if "mass" in t or "stiffness" in t else [])
     if len(sources) != 1:
+        got = [f"file = {t['file']!r}" if k == "file" else k for k in sources]
         raise CaseError(f"{path}: [model] give exactly one model source: mass/stiffness, file or builder"
-                        + (f" (got {', '.join(sources)})" if sources else ""))
+                        + (f" (got {', '.join(got)})" if sources else ""))
     if "builder" not in t:
         for k in BUILDER_TABLES:
             if k in t:
@@ -218,13 +221,16 @@ def _model(t, path, base_dir):
     points = {}
     C_file = None
     if "file" in t:
-        f = base_dir / str(t["file"])
+        if not isinstance(t["file"], str):
+            raise CaseError(f"{path}: [model] file must be a path (string), got {t['file']!r}")
+        f = base_dir / t["file"]
         if not f.is_file():
             raise CaseError(f"{path}: [model] file {str(f)!r} not found")
         try:
             data = load_model_file(f)
-        except ValueError as exc:
-            raise CaseError(f"{path}: [model] cannot read model file {str(f)!r}: {exc}") from None
+        except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile) as exc:
+            msg = " ".join(str(exc).split())
+            raise CaseError(f"{path}: [model] cannot read model file {str(f)!r}: {msg}") from None
         M, K, C_file, names = data.M, data.K, data.C, data.dof_names
         if "dof_names" in t:
             if names:
@@ -246,7 +252,19 @@ def _model(t, path, base_dir):
             if k not in t:
                 raise CaseError(f"{path}: [model] missing key {k!r}")
         M, K = _matrix(t["mass"], "mass", path), _matrix(t["stiffness"], "stiffness", path)
-        names = tuple(t.get("dof_names", ()))
+        names = t.get("dof_names", [])
+        if not (isinstance(names, list) and all(isinstance(x, str) for x in names)):
+            raise CaseError(f"{path}: [model] dof_names must be a list of strings, got {names!r}")
+        dup = sorted({x for x in names if names.count(x) > 1})
+        if dup:
+            raise CaseError(f"{path}: [model] dof_names repeats {dup[0]!r}")
+        names = tuple(names)
+    for name, A in (("mass", M), ("stiffness", K)):
+        if A.ndim != 2 or A.shape[0] != A.shape[1]:
+            raise CaseError(f"{path}: [model] {name} matrix must be square, got shape {A.shape}")
+    if K.shape != M.shape:
+        raise CaseError(f"{path}: [model] stiffness must be {M.shape[0]}x{M.shape[0]} like the mass "
+                        f"matrix, got {K.shape}")
     damping = _damping(t, path, M.shape[0])
     if damping is None:
         damping = Damping("matrix", C_file) if C_file is not None else Damping()
@@ -277,6 +295,8 @@ def _element_specs(specs, path):
         typ = spec.get("type")
         if typ is None:
             raise CaseError(f"{path}: {where}: missing key 'type'")
+        if not isinstance(typ, str):
+            raise CaseError(f"{path}: {where}: type must be a string (known: {', '.join(ELEMENTS)}), got {typ!r}")
         cls = ELEMENTS.get(typ)
         if cls is None:
             raise CaseError(f"{path}: {where}: unknown element type {typ!r} (known: {', '.join(ELEMENTS)})")
@@ -322,7 +342,10 @@ def _elements(specs, structure: Structure, path):
         try:
             out.append(cls.from_spec(spec, structure.n_dof, coords, where))
         except ValueError as exc:
-            raise CaseError(f"{path}: {exc}") from None
+            msg = str(exc)
+            if not msg.startswith(where.split(" (")[0]):       # a law parameter check: say which element
+                msg = f"{where}: {msg}"
+            raise CaseError(f"{path}: {msg}") from None
     return tuple(out)
 
 
@@ -396,8 +419,11 @@ def _analysis(t, model, elements, path):
         if k not in t:
             raise CaseError(f"{path}: [analysis] missing key {k!r}")
     needs_mean = any(e.needs_mean for e in elements)
+    hs = t.get("harmonics", 5)
+    if isinstance(hs, bool) or not isinstance(hs, (int, list)):
+        raise CaseError(f"{path}: [analysis] harmonics must be an integer H or a list of integers, got {hs!r}")
     try:
-        h = parse_harmonics(t.get("harmonics", 5), include_zero=needs_mean)
+        h = parse_harmonics(hs, include_zero=needs_mean)
     except ValueError as exc:
         raise CaseError(f"{path}: [analysis] {exc}") from None
     if 1 not in h:

@@ -9,6 +9,7 @@ the stability was computed.  ``frf.png`` draws unstable parts of the path dashed
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 
@@ -32,20 +33,27 @@ def peaks(freq: np.ndarray, amp: np.ndarray) -> list:
     return out
 
 
-def write_csv(res, path: Path) -> None:
+def format_csv(res) -> str:
+    """The ``frf.csv`` text of ``res`` (header row, one row per point along the path)."""
     names = list(res.outputs)
     enames = list(getattr(res, "element_outputs", {}))
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")] + enames + ["stable"])
+    for i, f in enumerate(res.freq_hz):
+        row = [f"{f:.10g}"]
+        for n in names:
+            o = res.outputs[n]
+            row += [f"{o.h1[i]:.10g}", f"{o.max[i]:.10g}"]
+        row += [f"{res.element_outputs[n][i]:.10g}" for n in enames]
+        row.append("" if res.stable is None else str(int(bool(res.stable[i]))))
+        w.writerow(row)
+    return buf.getvalue()
+
+
+def write_csv(res, path: Path) -> None:
     with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")] + enames + ["stable"])
-        for i, f in enumerate(res.freq_hz):
-            row = [f"{f:.10g}"]
-            for n in names:
-                o = res.outputs[n]
-                row += [f"{o.h1[i]:.10g}", f"{o.max[i]:.10g}"]
-            row += [f"{res.element_outputs[n][i]:.10g}" for n in enames]
-            row.append("" if res.stable is None else str(int(bool(res.stable[i]))))
-            w.writerow(row)
+        fh.write(format_csv(res))
 
 
 def _jumps(res):

@@ -99,8 +99,10 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
     else:
         try:
             h = parse_harmonics(harmonics, include_zero=any(e.needs_mean for e in case.elements))
-        except ValueError as exc:
+        except (ValueError, TypeError) as exc:
             raise CaseError(f"--harmonics: {exc}") from None
+        if 1 not in h:
+            raise CaseError(f"--harmonics must include 1 (the excitation's harmonic), got {list(map(int, h))}")
     if samples is None:
         N = a.time_samples if harmonics is None else max(a.time_samples, default_samples(h))
     else:
@@ -286,6 +288,65 @@ def _residual_scale(problem, w) -> float:
     return float(max(np.linalg.norm(R), 1e-300))
 
 
+POLISH_ENERGY = 1e-10
+
+
+def _polish(problem, X, w, xscale, r_scale, err):
+    """Newton at fixed ``w`` on a point whose energy balance is not closed.
+
+    The continuation's tolerance is relative to the Jacobian's row norm, which a stiff
+    contact (kt >> k) makes large against the excitation: such a point can be accepted with
+    ``|R| / |F|`` ~ 1e-9 and an energy error ~ 1e-6.  Here the target is relative to ``|F|``.
+    Returns the better of the two points and its relative energy error.
+    """
+    fun = lambda x: problem.residual(x.reshape(X.shape), w)[:2]
+    res = newton(fun, X.ravel(), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4)
+    if np.all(np.isfinite(res.x)):
+        Xp = res.x.reshape(X.shape)
+        err_p = energy_balance(problem, Xp, w).relative_error
+        if err_p < err:
+            return Xp, err_p
+    return X, err
+
+
+class _Path:
+    """Converged points of a traced path: coefficients, frequencies, outputs, iterations, errors."""
+
+    def __init__(self):
+        self.X, self.w, self.Y, self.its, self.err = [], [], [], [], []
+
+    def extend_reversed(self, other: "_Path") -> None:
+        for name in ("X", "w", "Y", "its", "err"):
+            getattr(self, name).extend(getattr(other, name)[::-1])
+
+
+def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, opts, progress, offset=0):
+    """One continuation from ``(X0, w0)`` in ``direction``; appends to ``pts``.
+
+    Returns ``(status, message, folds_hz, n_rejected)``.  Points whose energy balance is
+    looser than ``POLISH_ENERGY`` are polished by a fixed-frequency Newton solve.
+    """
+    scale = np.r_[xscale, bounds[1] - bounds[0]]
+    solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
+                       direction=direction, options=opts)
+    for pt in solver:
+        X = problem.expand(pt.x[:-1])
+        w = float(pt.x[-1])
+        err = energy_balance(problem, X, w).relative_error
+        if err > POLISH_ENERGY:
+            X, err = _polish(problem, X, w, xscale, r_scale, err)
+        pts.X.append(X)
+        pts.w.append(w)
+        pts.Y.append(recover_outputs(problem, case, X, w))
+        pts.its.append(pt.iterations if pts.w[1:] else it0 + pt.iterations)
+        pts.err.append(err)
+        if progress is not None:
+            progress(offset + len(pts.w), w / (2 * np.pi))
+        if offset + len(pts.w) >= case.analysis.max_points:
+            break
+    return solver.status, solver.message, [f / (2 * np.pi) for f in solver.folds], solver.n_rejected
+
+
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
         progress=None, options: ArclengthOptions | None = None, stability: bool = True,
         stability_options: StabilityOptions | None = None) -> FRFResult:
@@ -328,35 +389,44 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
                 "transform": problem.nl.transform.name, "stability": stability, **info}
     shape = (basis.n_coef, problem.n_dof)
-    pts_X, pts_w, pts_Y, its, eerr = [], [], [], [], []
+    pts = _Path()
     status, message, folds, n_rej = "failed", "", [], 0
+    segments = []
     try:
         X0, it0 = _first_point(problem, case, w_lo, xscale, r_scale)
     except RuntimeError as exc:
         message = str(exc)
     else:
-        scale = np.r_[xscale, w_hi - w_lo]
         opts = options or ArclengthOptions()
-        solver = Arclength(problem, np.r_[problem.unknowns(X0), w_lo], scale, lam_bounds=(w_lo, w_hi),
-                           direction=+1, options=opts)
-        for pt in solver:
-            X = problem.expand(pt.x[:-1])
-            w = float(pt.x[-1])
-            pts_X.append(X)
-            pts_w.append(w)
-            pts_Y.append(recover_outputs(problem, case, X, w))
-            its.append(pt.iterations if pts_w[1:] else it0 + pt.iterations)
-            eerr.append(energy_balance(problem, X, w).relative_error)
-            if progress is not None:
-                progress(len(pts_w), w / (2 * np.pi))
-            if len(pts_w) >= case.analysis.max_points:
-                break
-        status, message = solver.status, solver.message
-        if len(pts_w) >= case.analysis.max_points and status not in ("finished", "failed"):
+        seg = _trace(problem, case, pts, X0, it0, w_lo, (w_lo, w_hi), +1, xscale, r_scale, opts, progress)
+        status, message, folds, n_rej = seg
+        segments.append([0, len(pts.w)])
+        if status == "finished" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9):
+            # the branch folded back out of the window at fmin (e.g. a softening upper branch):
+            # the rest of the window lies on another branch, traced from fmax downwards
+            first_msg = (f"the branch from {lo:.6g} Hz folded back to {pts.w[-1] / (2 * np.pi):.6g} Hz; "
+                         f"traced the rest from {hi:.6g} Hz down")
+            part = _Path()
+            try:
+                Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
+            except RuntimeError as exc:
+                status, message = "failed", f"{first_msg}, but: {exc}"
+            else:
+                st2, msg2, f2, r2 = _trace(problem, case, part, Xh, ith, w_hi, (w_lo, w_hi), -1, xscale,
+                                           r_scale, opts, progress, offset=len(pts.w))
+                folds, n_rej = folds + f2, n_rej + r2
+                if st2 == "finished" and part.w and part.w[-1] > w_lo * (1 + 1e-9):
+                    st2 = "failed"
+                    msg2 = (f"the FRF between {part.w[-1] / (2 * np.pi):.6g} Hz and the first branch is not "
+                            f"traced: the branch from {hi:.6g} Hz folded back too")
+                status, message = st2, f"{first_msg}: {msg2}"
+                segments.append([len(pts.w), len(pts.w) + len(part.w)])
+                pts.extend_reversed(part)
+        if len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
             status = "max_steps"
-            message = f"stopped after max_points={case.analysis.max_points} points at {pts_w[-1] / (2 * np.pi):.6g} Hz"
-        folds = [f / (2 * np.pi) for f in solver.folds]
-        n_rej = solver.n_rejected
+            message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[-1] / (2 * np.pi):.6g} Hz"
+    pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
+    settings["segments"] = segments
     stable = None
     if stability:
         stable = np.array([point_stability(problem, X, w, stability_options).stable

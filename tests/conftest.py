@@ -20,3 +20,11 @@ def sdof_jenkins_case(m=1.0, k=1.0, c=0.02, kt=1.0, fs=0.3, F=1.0, f_hz=(0.1, 0.
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    """The stress matrix (tests/stress, ``-m stress``) leaves its verdict table here."""
+    table = getattr(config, "_stress_table", None)
+    if table:
+        terminalreporter.write_sep("=", "stress matrix")
+        terminalreporter.write_line(table)
