@@ -139,7 +139,10 @@ def dof_number(d, n_dof, dof_index, where) -> int:
 
 
 def coordinate_rows(specs, n_dof, dof_index=None, where="element") -> np.ndarray:
-    """Gather matrix rows for coordinates given as ``a``, ``[a]`` or ``[a, b]`` (``q_a - q_b``).
+    """Gather matrix rows for coordinates given as ``a``, ``[a]`` or ``[a, b]`` (``q_a - q_b``),
+    or as a table ``{dof = coefficient, ...}`` for a linear combination ``sum_d c_d q_d``
+    (e.g. a coordinate along an inclined face; TOML keys are DOF names, or indices written
+    as strings).
 
     Returns
     -------
@@ -147,6 +150,15 @@ def coordinate_rows(specs, n_dof, dof_index=None, where="element") -> np.ndarray
     """
     G = np.zeros((len(specs), n_dof))
     for r, spec in enumerate(specs):
+        if isinstance(spec, dict):
+            if not spec:
+                raise ValueError(f"{where}: a coordinate table {{dof = coefficient}} is empty")
+            for d, c in spec.items():
+                key = int(d) if isinstance(d, str) and d.isdigit() and (dof_index is None or d not in dof_index) else d
+                G[r, dof_number(key, n_dof, dof_index, where)] += _number(f"{where}: coefficient of {d!r}", c)
+            if not np.any(G[r]):
+                raise ValueError(f"{where}: coordinate {spec!r} has all coefficients zero")
+            continue
         items = spec if isinstance(spec, (list, tuple)) else [spec]
         if len(items) not in (1, 2):
             raise ValueError(f"{where}: dofs must be [a] or [a, b], got {spec!r}")

@@ -12,7 +12,8 @@ class Friction3D(Element):
     """Macroslip point contact on local coordinates (t1, t2, n), or (t1, n) without ``t2``.
 
     Case keys: ``type``, ``dofs = {t1 = [a, b] or a, t2 = ..., n = ...}`` (``[a, b]`` means
-    ``q_a - q_b``; ``t2`` optional), ``kt``, ``kn`` (> 0), ``mu`` (>= 0),
+    ``q_a - q_b``; a table ``{dof = coefficient, ...}`` a linear combination, e.g. along an
+    inclined face; ``t2`` optional), ``kt``, ``kn`` (> 0), ``mu`` (>= 0),
     ``normal_preload`` (``N0 >= 0``), optional ``name``.
 
     The normal load is ``N = max(N0 + kn u_n, 0)`` (``u_n > 0`` closes); the element force
