@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 CASE ?= rigs/sdof_jenkins.toml
 
-.PHONY: run test bench setup clean
+.PHONY: run test bench setup clean rigs rig-studies
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -20,6 +20,14 @@ run: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest tests
+
+# regenerate the rigs' model files (one script per rig, listed in rigs/make_all.py)
+rigs: $(STAMP)
+	$(BIN)/python rigs/make_all.py
+
+# the rigs' studies: figures in rigs/figures, tables in rigs/out (several minutes)
+rig-studies: $(STAMP)
+	$(BIN)/python rigs/make_all.py --studies
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/time_vs_error.py

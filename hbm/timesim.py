@@ -13,7 +13,7 @@ exactly at every (sub-)step end; only the free DOFs are unknowns (their rows of 
 above), and the supports drive them through the coupling terms of ``M``, ``C``, ``K`` and
 through every element attached to them (the elements see ``G q`` with the supports' motion).
 The support reactions are not computed.  The run starts with the supports at ``A_b`` and the
-free DOFs at the quasi-static position ``K_ff q_f = -K_fb A_b``.
+free DOFs at the quasi-static position ``K_ff q_f = -K_fb A_b`` (elements stuck).
 
 Scheme
 ------
@@ -647,8 +647,9 @@ class _State:
 
     Start: at rest, except that support DOFs start at their prescribed position ``A`` (cosine
     at ``t = 0``, velocity 0, acceleration ``-A w^2``) and the free DOFs at the quasi-static
-    position that follows it, ``K_ff q_f = -K_fs A`` (a rigid translation when the supports
-    carry the structure), so that the run does not begin with a jolt.
+    position that follows it, ``K_ff q_f = -K_fs A`` with ``K`` including the elements'
+    stuck stiffness (a rigid translation when the supports carry the structure), so that the
+    run does not begin with a jolt.
     """
 
     def __init__(self, case: Case, packed: _Packed, F: np.ndarray, w: float = 0.0):
@@ -661,7 +662,9 @@ class _State:
         self.v = np.zeros(n)
         if fx.size:
             self.q[fx] = ybase[fx]
-            self.q[fr] = -np.linalg.solve(K[np.ix_(fr, fr)], K[np.ix_(fr, fx)] @ ybase[fx])
+            Ks = K + sum((e.gather.T @ e.linear_stiffness() @ e.gather for e in case.elements),
+                         np.zeros_like(K))
+            self.q[fr] = -np.linalg.lstsq(Ks[np.ix_(fr, fr)], Ks[np.ix_(fr, fx)] @ ybase[fx], rcond=None)[0]
         self.S = np.zeros(int(packed.s_off[-1]))
         self.D = np.zeros(int(packed.d_off[-1]))
         self.Dref = np.zeros(packed.kinds.size)
