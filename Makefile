@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 CASE ?= rigs/sdof_jenkins.toml
 
-.PHONY: run test stress bench rigs setup clean
+.PHONY: run test stress bench rigs rig-studies setup clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -24,6 +24,14 @@ test: $(STAMP)
 # the full stress matrix (minutes; STRESS_JOBS=n worker processes, default: all cores)
 stress: $(STAMP)
 	$(BIN)/python -m pytest tests/stress -m stress
+
+# regenerate the rigs' model files (one script per rig, listed in rigs/make_all.py)
+rigs: $(STAMP)
+	$(BIN)/python rigs/make_all.py
+
+# the rigs' studies: figures in rigs/figures, tables in rigs/out (several minutes)
+rig-studies: $(STAMP)
+	$(BIN)/python rigs/make_all.py --studies
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/time_vs_error.py

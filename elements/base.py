@@ -273,7 +273,7 @@ def coordinate_row(spec, n_dof, dof_index=None, where="element") -> np.ndarray:
 
 def coordinate_rows(specs, n_dof, dof_index=None, where="element") -> np.ndarray:
     """Gather matrix rows for coordinates given as ``a``, ``[a]``, ``[a, b]`` (``q_a - q_b``)
-    or ``[[a, ca], [b, cb], ...]`` (``ca q_a + cb q_b + ...``); see :func:`coordinate_row`.
+    or ``[[a, ca], [b, cb], ...]`` / ``{a = ca, b = cb}`` (``ca q_a + cb q_b + ...``); see :func:`coordinate_row`.
 
     ``where`` may be a string (used for every row) or a sequence with one label per row.
 

@@ -19,7 +19,8 @@ class Friction3D(Element):
 
     - ``a`` or ``[a]``: ``q_a``;  ``[a, b]``: ``q_a - q_b`` (contact between two bodies whose
       DOFs are along the contact axes);
-    - ``[[a, ca], [b, cb], ...]``: ``ca q_a + cb q_b + ...``, pairs of DOF and coefficient,
+    - ``[[a, ca], [b, cb], ...]`` or a table ``{a = ca, b = cb}``: ``ca q_a + cb q_b + ...``,
+      pairs of DOF and coefficient (TOML table keys: DOF names, or indices as strings),
       for contact directions not along the model axes.  A mass with DOFs x (0) and y (1)
       against a wall inclined by 30 degrees::
 

@@ -92,7 +92,8 @@ def _names(arr):
 
 
 def read_npz(path) -> ModelData:
-    """Read ``M``, ``K``, optional ``C`` and ``dof_names`` from an ``.npz`` file."""
+    """Read ``M``, ``K``, optional ``C`` and ``dof_names`` from an ``.npz`` file (arrays named
+    ``meta_*`` are ignored; any other array is an error naming it)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"model file not found: {path}")
@@ -100,7 +101,9 @@ def read_npz(path) -> ModelData:
         for key in ("M", "K"):
             if key not in z:
                 raise ValueError(f"{path}: missing array {key!r} (needs M and K)")
-        unknown = set(z.files) - {"M", "K", "C", "dof_names"}
+        # arrays named meta_* carry documentation (e.g. the design values a rig was built
+        # from) and are not part of the model; any other extra array is an error
+        unknown = {k for k in z.files if not k.startswith("meta_")} - {"M", "K", "C", "dof_names"}
         if unknown:
             raise ValueError(f"{path}: unknown array(s) {sorted(unknown)}")
         C = np.asarray(z["C"], dtype=float) if "C" in z else None

@@ -7,6 +7,14 @@ Equations of motion (the same model, elements and excitation as the harmonic bal
     M \ddot q + C \dot q + K q + \sum_e G_e^T f_e = F \cos(w t) \quad (t \le t_{off}),
     \qquad F = 0 \ \text{after} \ t_{off}.
 
+Base (support) excitation (``[excitation] base``): the support DOFs ``b`` follow the prescribed
+motion ``q_b(t) = A_b cos(w t)`` with ``v_b = -w A_b sin(w t)``, ``a_b = -w^2 A_b cos(w t)``
+exactly at every (sub-)step end; only the free DOFs are unknowns (their rows of the equations
+above), and the supports drive them through the coupling terms of ``M``, ``C``, ``K`` and
+through every element attached to them (the elements see ``G q`` with the supports' motion).
+The support reactions are not computed.  The run starts with the supports at ``A_b`` and the
+free DOFs at the quasi-static position ``K_ff q_f = -K_fb A_b`` (elements stuck).
+
 Scheme
 ------
 HHT-alpha (Hilber-Hughes-Taylor) with ``alpha`` in [-1/3, 0]; ``alpha = 0`` (the default) is
@@ -190,14 +198,24 @@ def _max_abs(x):
 def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
           q0, v0, a0, f0, q1, v1, a1, f1,
           kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
-          S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp):
+          S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp,
+          fixed, ybase, w, th1):
     """One HHT/Newmark step of size ``h`` by Newton; returns iterations, or -1 on failure.
 
     ``q1`` enters as the predictor and leaves as the solution; ``S_trial``/``D_trial`` hold the
     element states/tangents at the solution (not committed here).  ``Jinv`` caches the inverse
     iteration matrix for the step size ``h_c[0]`` and element tangent ``Kt_c``.
+
+    Support DOFs (``fixed[i] != 0``) take the prescribed motion ``ybase[i] cos(th1)`` with its
+    exact velocity and acceleration at the step's end; their rows of the residual are dropped
+    (identity rows and columns in the iteration matrix), so only the free DOFs are unknowns.
     """
     n = q0.size
+    cth = np.cos(th1)
+    sth = np.sin(th1)
+    for i in range(n):
+        if fixed[i] != 0:
+            q1[i] = ybase[i] * cth
     gamma = 0.5 - alpha
     beta = 0.25 * (1.0 - alpha) ** 2
     c0 = 1.0 / (beta * h * h)
@@ -205,6 +223,8 @@ def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
     ca = 1.0 / (2.0 * beta) - 1.0
     mrow = 0.0
     for i in range(n):
+        if fixed[i] != 0:       # a support's own row is not solved: its mass plays no part
+            continue
         r = 0.0
         for j in range(n):
             r += abs(M[i, j])
@@ -217,8 +237,12 @@ def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
         tmp[i] = -alpha * old + alpha * load0 * F[i] - (1.0 + alpha) * load1 * F[i]
     for it in range(max_iter + 1):
         for i in range(n):
-            a1[i] = c0 * (q1[i] - q0[i] - h * v0[i]) - ca * a0[i]
-            v1[i] = v0[i] + h * ((1.0 - gamma) * a0[i] + gamma * a1[i])
+            if fixed[i] != 0:
+                a1[i] = -w * w * ybase[i] * cth
+                v1[i] = -w * ybase[i] * sth
+            else:
+                a1[i] = c0 * (q1[i] - q0[i] - h * v0[i]) - ca * a0[i]
+                v1[i] = v0[i] + h * ((1.0 - gamma) * a0[i] + gamma * a1[i])
         _eval_elements(q1, v1, c1, kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
                        S, S_trial, D_trial, f1, Kt, z, Abuf, Bbuf, Keff)
         rnorm = 0.0
@@ -231,6 +255,9 @@ def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
                 inert += M[i, j] * a1[j]
                 restore += C[i, j] * v1[j] + K[i, j] * q1[j]
             R[i] = inert + (1.0 + alpha) * restore + tmp[i]
+            if fixed[i] != 0:
+                R[i] = 0.0
+                continue
             rnorm = max(rnorm, abs(R[i]))
             big_i = max(big_i, abs(inert))
             big_r = max(big_r, abs(restore))
@@ -255,6 +282,11 @@ def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
                     break
         if not same:
             J = c0 * M + (1.0 + alpha) * (c1 * C + K + Kt)
+            for i in range(n):
+                if fixed[i] != 0:
+                    J[i, :] = 0.0
+                    J[:, i] = 0.0
+                    J[i, i] = 1.0
             Jinv[:, :] = np.linalg.inv(J)
             Kt_c[:, :] = Kt
             h_c[0] = h
@@ -267,13 +299,14 @@ def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
 
 
 @nb.njit(cache=True)
-def _record(row, q, S, s_off, g_all, g_off, rec_q, rec_f, rec_u):
+def _record(row, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v):
     rec_q[row, :] = q
     c = 0
     for e in range(g_off.size - 1):
         for i in range(g_off[e + 1] - g_off[e]):
             rec_f[row, c] = S[s_off[e] + i]
             rec_u[row, c] = _gather(g_all, g_off[e] + i, q)
+            rec_v[row, c] = _gather(g_all, g_off[e] + i, v)
             c += 1
 
 
@@ -282,7 +315,7 @@ def _march(M, C, K, F, w, t_off, N, k0, n_periods, check, tol, have_prev,
            q, v, a, fnl, S, D, Dref,
            kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
            alpha, newton_tol, max_iter, max_level, jump_tol,
-           rec_mode, rec_q, rec_f, rec_u, prev, cur, stats):
+           rec_mode, rec_q, rec_f, rec_u, rec_v, prev, cur, stats, fixed, ybase):
     """Integrate ``n_periods`` whole periods of ``N`` steps from global step ``k0``.
 
     The state ``q, v, a, fnl, S, D, Dref`` is updated in place.  ``rec_mode`` 0 records the
@@ -330,9 +363,9 @@ def _march(M, C, K, F, w, t_off, N, k0, n_periods, check, tol, have_prev,
     k = k0
     for pp in range(n_periods):
         if rec_mode == 0:
-            _record(0, q, S, s_off, g_all, g_off, rec_q, rec_f, rec_u)
+            _record(0, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
         elif k < rec_q.shape[0]:
-            _record(k, q, S, s_off, g_all, g_off, rec_q, rec_f, rec_u)
+            _record(k, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
         for j in range(1, N + 1):
             # one output step from global index k to k + 1, in dyadic sub-steps
             pos = 0
@@ -352,7 +385,8 @@ def _march(M, C, K, F, w, t_off, N, k0, n_periods, check, tol, have_prev,
                 its = _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
                             q, v, a, fnl, q1, v1, a1, f1,
                             kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
-                            S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp)
+                            S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp,
+                            fixed, ybase, w, th1)
                 if its < 0:
                     stats[3] += 1
                     if lev >= max_level:
@@ -399,9 +433,9 @@ def _march(M, C, K, F, w, t_off, N, k0, n_periods, check, tol, have_prev,
             if check:
                 cur[j - 1, :] = q
             if rec_mode == 0:
-                _record(j, q, S, s_off, g_all, g_off, rec_q, rec_f, rec_u)
+                _record(j, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
             elif k < rec_q.shape[0]:
-                _record(k, q, S, s_off, g_all, g_off, rec_q, rec_f, rec_u)
+                _record(k, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
         if check:
             diff = 0.0
             scale = 0.0
@@ -482,6 +516,8 @@ class History:
     disp : ndarray, shape (n_rows, n_forces)
         The matching element coordinates ``G q``.
     force_names : tuple of str
+    vel : ndarray, shape (n_rows, n_forces)
+        The element coordinates' velocities ``G v`` (e.g. the relative sliding velocity).
     """
 
     t: np.ndarray
@@ -489,6 +525,7 @@ class History:
     forces: np.ndarray
     disp: np.ndarray
     force_names: tuple
+    vel: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -597,21 +634,51 @@ def pack_elements(elements, n_dof: int) -> _Packed:
                    np.ascontiguousarray(g_all, dtype=float), g_off, vel, d_off, tuple(names))
 
 
-class _State:
-    """The integrator state carried between chunks (and from the n run to the 2n run)."""
+def _support(case: Case):
+    """``fixed`` (n,) int64 flags of the support DOFs and ``ybase`` (n,) their amplitudes."""
+    n = case.n_dof
+    fixed = np.zeros(n, dtype=np.int64)
+    ybase = np.zeros(n)
+    if case.excitation.base is not None:
+        bd, ba = case.excitation.base
+        fixed[np.asarray(bd, dtype=int)] = 1
+        ybase[np.asarray(bd, dtype=int)] = np.asarray(ba, dtype=float)
+    return fixed, ybase
 
-    def __init__(self, case: Case, packed: _Packed, F: np.ndarray):
+
+class _State:
+    """The integrator state carried between chunks (and from the n run to the 2n run).
+
+    Start: at rest, except that support DOFs start at their prescribed position ``A`` (cosine
+    at ``t = 0``, velocity 0, acceleration ``-A w^2``) and the free DOFs at the quasi-static
+    position that follows it, ``K_ff q_f = -K_fs A`` with ``K`` including the elements'
+    stuck stiffness (a rigid translation when the supports carry the structure), so that the
+    run does not begin with a jolt.
+    """
+
+    def __init__(self, case: Case, packed: _Packed, F: np.ndarray, w: float = 0.0):
         n = case.n_dof
+        M, C, K = case.model.M, case.model.C, case.model.K
+        fixed, ybase = _support(case)
+        fx = np.flatnonzero(fixed)
+        fr = np.flatnonzero(fixed == 0)
         self.q = np.zeros(n)
         self.v = np.zeros(n)
+        if fx.size:
+            self.q[fx] = ybase[fx]
+            Ks = K + sum((e.gather.T @ e.linear_stiffness() @ e.gather for e in case.elements),
+                         np.zeros_like(K))
+            self.q[fr] = -np.linalg.lstsq(Ks[np.ix_(fr, fr)], Ks[np.ix_(fr, fx)] @ ybase[fx], rcond=None)[0]
         self.S = np.zeros(int(packed.s_off[-1]))
         self.D = np.zeros(int(packed.d_off[-1]))
         self.Dref = np.zeros(packed.kinds.size)
         _init_states(*packed.args(), self.q, self.v, self.S, self.D, self.Dref)
         self.fnl = np.zeros(n)
         _element_forces(self.S, packed.s_off, packed.g_all, packed.g_off, self.q, self.fnl)
-        M, C, K = case.model.M, case.model.C, case.model.K
-        self.a = np.linalg.solve(M, F - C @ self.v - K @ self.q - self.fnl)
+        self.a = np.zeros(n)
+        self.a[fx] = -w * w * ybase[fx]
+        rhs = F - C @ self.v - K @ self.q - self.fnl - M[:, fx] @ self.a[fx]
+        self.a[fr] = np.linalg.solve(M[np.ix_(fr, fr)], rhs[fr])
 
     def copy(self):
         other = object.__new__(_State)
@@ -620,9 +687,10 @@ class _State:
         return other
 
 
-def _check_supported(case: Case) -> None:
-    if case.excitation.base is not None:
-        raise CaseError(f"{case.path}: timesim does not support [excitation] base (support motion) yet")
+def _check_supported(case: Case, switch_off_at=None) -> None:
+    if case.excitation.base is not None and switch_off_at is not None:
+        raise CaseError(f"{case.path}: a switch-off time is not supported with [excitation] base "
+                        f"(support motion cannot stop abruptly)")
 
 
 def _check_freq(freq_hz):
@@ -666,6 +734,8 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     rec_q = np.zeros((rows, n))
     rec_f = np.zeros((rows, n_f))
     rec_u = np.zeros((rows, n_f))
+    rec_v = np.zeros((rows, n_f))
+    fixed, ybase = _support(case)
     prev = np.zeros((N if check else 1, n))
     cur = np.zeros_like(prev)
     stats = np.zeros(4, dtype=np.int64)
@@ -681,7 +751,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
             state.q, state.v, state.a, state.fnl, state.S, state.D, state.Dref,
             *packed.args(), float(opts.alpha), float(opts.newton_tol), int(opts.max_iter),
             int(opts.max_level), float(opts.jump_tol),
-            0 if check else 1, rec_q, rec_f, rec_u, prev, cur, stats)
+            0 if check else 1, rec_q, rec_f, rec_u, rec_v, prev, cur, stats, fixed, ybase)
         done += pp
         if ch >= 0:
             change = ch
@@ -700,7 +770,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
         t = (period_offset + done - 1) * T + np.arange(N + 1) * (T / N)
     else:
         t = np.arange(rows) * (T / N)
-    hist = History(t, rec_q, rec_f, rec_u, packed.names)
+    hist = History(t, rec_q, rec_f, rec_u, packed.names, rec_v)
     h1, mx = _amplitudes(case, hist, N)
     st = {"newton_iterations": int(stats[0]), "substeps": int(stats[1]),
           "refinements": int(stats[2]), "newton_failures": int(stats[3])}
@@ -728,7 +798,8 @@ def steady_state(case: Case, freq_hz: float, options: TimeSimOptions | None = No
     opts = options or TimeSimOptions()
     opts.validate()
     f = _check_freq(freq_hz)
-    state = _State(case, pack_elements(case.elements, case.n_dof), case.excitation.force)
+    _check_supported(case)
+    state = _State(case, pack_elements(case.elements, case.n_dof), case.excitation.force, 2 * np.pi * f)
     return _integrate(case, f, opts, opts.steps, opts.max_periods, True, None, state, progress)
 
 
@@ -749,7 +820,8 @@ def transient(case: Case, freq_hz: float, periods: int, switch_off_at: float | N
         raise CaseError(f"periods must be an integer >= 1, got {periods!r}")
     if switch_off_at is not None and not (switch_off_at >= 0 and math.isfinite(switch_off_at)):
         raise CaseError(f"switch-off time must be >= 0 s, got {switch_off_at!r}")
-    state = _State(case, pack_elements(case.elements, case.n_dof), case.excitation.force)
+    _check_supported(case, switch_off_at)
+    state = _State(case, pack_elements(case.elements, case.n_dof), case.excitation.force, 2 * np.pi * f)
     return _integrate(case, f, opts, opts.steps, int(periods), False, switch_off_at, state, progress)
 
 
@@ -785,11 +857,11 @@ def timesim(case: Case, freq_hz: float, options: TimeSimOptions | None = None,
     opts = options or TimeSimOptions()
     opts.validate()
     f = _check_freq(freq_hz)
-    _check_supported(case)
+    _check_supported(case, switch_off_at)
     t0 = time.perf_counter()
     if periods is None:
         packed = pack_elements(case.elements, case.n_dof)
-        state = _State(case, packed, case.excitation.force)
+        state = _State(case, packed, case.excitation.force, 2 * np.pi * f)
         coarse = _integrate(case, f, opts, opts.steps, opts.max_periods, True, None, state, progress)
         fine = _integrate(case, f, opts, 2 * opts.steps, opts.max_periods, True, None, state,
                           progress, period_offset=coarse.periods)

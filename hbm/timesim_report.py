@@ -2,8 +2,9 @@
 
 ``timesim.csv``: one header row ``freq_hz``, ``NAME_h1``, ``NAME_max`` per output,
 ``error_estimate``, ``periods``; one data row.  ``history.csv``: ``t``, then every output,
-then every element force component (the last period in steady mode, everything in transient
-mode).
+then every element force component ``<name>_f...``, then the matching element coordinates
+``<name>_u...`` and their velocities ``<name>_v...`` (e.g. the relative sliding velocity), over
+the last period in steady mode and everything in transient mode.
 """
 from __future__ import annotations
 
@@ -26,14 +27,25 @@ def write_summary_csv(case, res, path: Path) -> None:
         w.writerow(row)
 
 
+def _coord_name(force_name: str, kind: str) -> str:
+    """``elem_f`` -> ``elem_u`` / ``elem_v``; ``elem_f_t1`` -> ``elem_u_t1`` / ``elem_v_t1``."""
+    head, sep, tail = force_name.rpartition("_f")
+    return f"{head}_{kind}{tail}" if sep else f"{force_name}_{kind}"
+
+
 def write_history_csv(case, res, path: Path) -> None:
     hist = res.history
     outs = case.analysis.outputs
-    cols = [hist.t] + [hist.q @ g for g in outs.values()] + [hist.forces[:, i] for i in range(hist.forces.shape[1])]
+    n_f = hist.forces.shape[1]
+    cols = [hist.t] + [hist.q @ g for g in outs.values()] + [hist.forces[:, i] for i in range(n_f)]
+    cols += [hist.disp[:, i] for i in range(n_f)]
+    cols += [hist.vel[:, i] for i in range(n_f)]
+    names = ["t"] + list(outs) + list(hist.force_names)
+    names += [_coord_name(n, "u") for n in hist.force_names] + [_coord_name(n, "v") for n in hist.force_names]
     data = np.column_stack(cols)
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["t"] + list(outs) + list(hist.force_names))
+        w.writerow(names)
         for r in data:
             w.writerow([f"{x:.10g}" for x in r])
 

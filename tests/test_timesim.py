@@ -222,7 +222,7 @@ def test_cli_writes_files(tmp_path):
     vals = [float(v) for v in rows[1]]
     assert vals[0] == 0.2 and vals[1] > 0 and vals[2] >= vals[1] * 0.9 and 0 < vals[3] < 0.05 and vals[4] > 2
     hist = list(csv.reader(open(out / "history.csv")))
-    assert hist[0] == ["t", "x", "jenkins0_f"] and len(hist) == 2 + 128   # last period at 2n steps
+    assert hist[0] == ["t", "x", "jenkins0_f", "jenkins0_u", "jenkins0_v"] and len(hist) == 2 + 128   # last period at 2n steps
     assert (out / "timesim.png").stat().st_size > 1000
     assert "error estimate" in r.stdout
     # transient mode: the whole history

@@ -1,0 +1,41 @@
+"""Regenerate every rig's model file (``make rigs``); with ``--studies`` also rerun the rigs'
+studies (figures in ``rigs/figures``, tables in ``rigs/out``; minutes).
+
+One entry per rig: ``(model script, [study scripts])``, run in order with this interpreter.
+"""
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+RIGS = {
+    "cross_beam": ("make_cross_beam_model.py", ["studies/cross_beam_study.py"]),
+    "railcar_wedge": ("make_railcar_wedge_model.py", ["studies/railcar_wedge_sweep.py"]),
+}
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--studies", action="store_true", help="also run the studies (slow)")
+    p.add_argument("rigs", nargs="*", help=f"subset of: {', '.join(RIGS)}")
+    args = p.parse_args(argv)
+    unknown = [r for r in args.rigs if r not in RIGS]
+    if unknown:
+        sys.stderr.write(f"make_all: unknown rig {unknown[0]!r} (known: {', '.join(RIGS)})\n")
+        return 2
+    for name in args.rigs or RIGS:
+        model, studies = RIGS[name]
+        for script in [model] + (studies if args.studies else []):
+            print(f"== {name}: {script}", flush=True)
+            r = subprocess.run([sys.executable, str(HERE / script)], cwd=HERE.parent)
+            if r.returncode:
+                return r.returncode
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
