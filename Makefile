@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 CASE ?= rigs/sdof_jenkins.toml
 
-.PHONY: run test stress bench rigs rig-studies setup clean
+.PHONY: run test stress bench rigs rig-models setup clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -25,20 +25,17 @@ test: $(STAMP)
 stress: $(STAMP)
 	$(BIN)/python -m pytest tests/stress -m stress
 
-# regenerate the rigs' model files (one script per rig, listed in rigs/make_all.py)
+# every figure and table of the rig documents, and the rigs' model files (tens of minutes;
+# the scripts are listed per rig in rigs/make_all.py)
 rigs: $(STAMP)
-	$(BIN)/python rigs/make_all.py
-
-# the rigs' studies: figures in rigs/figures, tables in rigs/out (several minutes)
-rig-studies: $(STAMP)
 	$(BIN)/python rigs/make_all.py --studies
+
+# the rigs' model files only
+rig-models: $(STAMP)
+	$(BIN)/python rigs/make_all.py
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/time_vs_error.py
-
-# every rig's document: figures and tables (each rigs/make_*.py regenerates one rig)
-rigs: $(STAMP)
-	set -e; for f in rigs/make_*.py; do echo "== $$f"; $(BIN)/python $$f; done
 
 clean:
 	rm -rf out .pytest_cache

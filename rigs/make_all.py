@@ -1,7 +1,8 @@
-"""Regenerate every rig's model file (``make rigs``); with ``--studies`` also rerun the rigs'
-studies (figures in ``rigs/figures``, tables in ``rigs/out``; minutes).
+"""Regenerate every rig's model file (``make rig-models``); with ``--studies`` also rerun the
+rigs' studies, i.e. every figure and table of the rig documents (``make rigs``; minutes).
 
-One entry per rig: ``(model script, [study scripts])``, run in order with this interpreter.
+One entry per rig: ``(model script or None, [study scripts])``, paths relative to the
+repository root, run in order with this interpreter.
 """
 from __future__ import annotations
 
@@ -13,8 +14,11 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 
 RIGS = {
-    "cross_beam": ("make_cross_beam_model.py", ["studies/cross_beam_study.py"]),
-    "railcar_wedge": ("make_railcar_wedge_model.py", ["studies/railcar_wedge_sweep.py"]),
+    "cross_beam": ("rigs/make_cross_beam_model.py", ["rigs/studies/cross_beam_study.py"]),
+    "railcar_wedge": ("rigs/make_railcar_wedge_model.py", ["rigs/studies/railcar_wedge_sweep.py"]),
+    "blade_couple": (None, ["rigs/make_blade_couple.py"]),
+    "beam_damper_beam": ("rigs/builders/beam_damper_beam.py",
+                         ["benchmarks/beam_damper_beam_study.py", "benchmarks/brush_loops.py"]),
 }
 
 
@@ -29,9 +33,9 @@ def main(argv=None) -> int:
         return 2
     for name in args.rigs or RIGS:
         model, studies = RIGS[name]
-        for script in [model] + (studies if args.studies else []):
+        for script in ([model] if model else []) + (studies if args.studies else []):
             print(f"== {name}: {script}", flush=True)
-            r = subprocess.run([sys.executable, str(HERE / script)], cwd=HERE.parent)
+            r = subprocess.run([sys.executable, str(HERE.parent / script)], cwd=HERE.parent)
             if r.returncode:
                 return r.returncode
     return 0
