@@ -140,11 +140,13 @@ def make_transform(basis: FourierBasis, name: str = "auto"):
     """Transform by name (``dft``, ``numpy``, ``fftw``) or ``auto``.
 
     ``auto`` takes the DFT matrices while ``n_coef`` is small (a matrix product of
-    ``n_coef x N`` beats an FFT of ``N log N`` there) and FFTW (NumPy when pyFFTW is missing)
-    above; the crossover was measured by ``benchmarks/time_vs_error.py``.
+    ``n_coef x N`` beats an FFT of ``N log N`` plus its bookkeeping there) and FFTW (NumPy
+    when pyFFTW is missing) above.  Measured by ``benchmarks/time_vs_error.py`` (section 2):
+    the DFT still wins at H = 25 (n_coef = 51, N = 256: 73 us against 97 us NumPy, 110 us
+    FFTW), so the crossover is set at n_coef = 64.
     """
     if name == "auto":
-        if basis.n_coef <= 32:
+        if basis.n_coef <= 64:
             name = "dft"
         else:
             name = "fftw" if fftw_available() else "numpy"
