@@ -295,16 +295,15 @@ def section_target():
     t_call /= n
     tr = pb.nl.transform
     Xnl = X[:, pb.nl.dofs]
-    sig = [(Xnl @ G.T, np.zeros((256, G.shape[0] * (b.n_coef + 1)))) for G in pb.nl._G]
+    sig = [(Xnl @ G.T, np.zeros((256, G.shape[0] * (b.n_coef + 1))), G.shape[0]) for G in pb.nl._G]
 
     def transforms():
-        for U, d in sig:
+        for U, d, nl in sig:
             tr.synthesize(U)
-            tr.analyse(d[:, :G.shape[0]])
+            tr.analyse(d[:, :nl])
             tr.analyse(d)
     t_tr, _ = cpu(lambda: [transforms() for _ in range(n)])
     t_tr /= n
-    A = np.hstack([J[:, :-1], np.zeros((J.shape[0], 0))])
     Ab = np.vstack([J, np.ones((1, J.shape[1]))])
     t_lin, _ = cpu(lambda: [np.linalg.solve(Ab, np.ones(Ab.shape[0])) for _ in range(n)])
     t_lin /= n
