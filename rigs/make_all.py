@@ -15,6 +15,7 @@ HERE = Path(__file__).resolve().parent
 RIGS = {
     "cross_beam": ("make_cross_beam_model.py", ["studies/cross_beam_study.py"]),
     "railcar_wedge": ("make_railcar_wedge_model.py", ["studies/railcar_wedge_sweep.py"]),
+    "upd_rig": (None, ["make_upd_rig.py"]),      # no model file: the case builds its beams
 }
 
 
@@ -29,7 +30,7 @@ def main(argv=None) -> int:
         return 2
     for name in args.rigs or RIGS:
         model, studies = RIGS[name]
-        for script in [model] + (studies if args.studies else []):
+        for script in ([model] if model else []) + (studies if args.studies else []):
             print(f"== {name}: {script}", flush=True)
             r = subprocess.run([sys.executable, str(HERE / script)], cwd=HERE.parent)
             if r.returncode:
