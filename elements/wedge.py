@@ -38,13 +38,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, dof_number
+from .base import Element, coordinate
 from .friction3d import Friction3D
 from .kinds import FRICTION3D
 from .wedge_params import KEYS, WedgeParams, parse_params, _sides
 from .wedge_statics import flank_frames
 
 SIDES = ("left", "right")
+
+
+def _as_row(c) -> dict:
+    """A platform coordinate as ``{dof: coefficient}`` (an int is one DOF with coefficient 1)."""
+    if isinstance(c, dict):
+        return {int(k): float(v) for k, v in c.items()}
+    return {int(c): 1.0}
+
+
+def _sub(g, row, scale):
+    """``g -= scale * row`` for a coordinate ``row`` given as ``{dof: coefficient}``."""
+    for j, c in row.items():
+        g[j] -= scale * c
 
 
 def _cross(r, v):
@@ -58,8 +71,10 @@ class WedgeDamper(Element):
     Parameters
     ----------
     params : WedgeParams
-    platform : sequence of 2 tuples of int
-        Platform DOFs ``(x, y)`` or ``(x, y, z)`` of the left and right contacts.
+    platform : sequence of 2 tuples
+        Platform coordinates ``(x, y)`` or ``(x, y, z)`` of the left and right contacts, each
+        a DOF index or a combination ``{dof: coefficient}`` (a point coordinate such as
+        ``"blade1.platform.x"`` of a beam assembly, ``u_p = u_n + theta_n x r``).
     damper : sequence of int
         Model indices of the damper DOFs, in the order ``params.dof_suffixes``.
     n_dof : int
@@ -84,8 +99,9 @@ class WedgeDamper(Element):
         p = params.points_per_flank
         col = dict(zip(params.dof_suffixes, self.damper_index))
         contacts, flank = [], []
+        rows_of = [[_as_row(c) for c in platform[s]] for s in range(2)]
         for s in range(2):
-            ps = platform[s]
+            ps = rows_of[s]
             centre = params.centres[s] if params.rotates else np.zeros(2)
             for j, off in enumerate(params.point_offsets()):
                 r = centre + off * t[s]
@@ -96,15 +112,15 @@ class WedgeDamper(Element):
                             continue
                         g = np.zeros(n_dof)
                         g[col["z"]] += 1.0
-                        g[ps[2]] -= 1.0
+                        _sub(g, ps[2], 1.0)
                     else:
                         g = np.zeros(n_dof)
                         g[col["x"]] += v[0]
                         g[col["y"]] += v[1]
                         if params.rotates:
                             g[col["rz"]] += _cross(r, v)
-                        g[ps[0]] -= v[0]
-                        g[ps[1]] -= v[1]
+                        _sub(g, ps[0], v[0])
+                        _sub(g, ps[1], v[1])
                     rows.append(g)
                 label = f"{name}.{'LR'[s]}{j}"
                 contacts.append(Friction3D(np.array(rows), params.kt / p, params.kn / p, params.mu[s],
@@ -144,7 +160,7 @@ class WedgeDamper(Element):
         platform = []
         for side, d in zip(SIDES, _sides(spec, where)):
             keys = ("x", "y", "z") if params.three_d else ("x", "y")
-            platform.append(tuple(dof_number(d[k], n_dof, dof_index, f"{where}: {side}.{k}") for k in keys))
+            platform.append(tuple(coordinate(d[k], n_dof, dof_index, f"{where}: {side}.{k}") for k in keys))
         damper = []
         for s in params.dof_suffixes:
             dn = f"{name}.{s}"
@@ -152,7 +168,7 @@ class WedgeDamper(Element):
                 raise ValueError(f"{where}: damper DOF {dn!r} is not in the model (wedge_damper adds "
                                  f"its DOFs when the case is loaded by hbm.case)")
             damper.append(int(dof_index[dn]))
-        used = {i for pl in platform for i in pl}
+        used = {i for pl in platform for c in pl for i in c}
         if used & set(damper):
             raise ValueError(f"{where}: platform DOFs must not be damper DOFs")
         return cls(params, platform, damper, n_dof, name)
