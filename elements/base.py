@@ -139,6 +139,20 @@ def slider_summary(f, u, kt) -> dict:
     }
 
 
+def principal_reversal(ut: np.ndarray) -> int:
+    """Sample where a tangential motion ``ut`` (N, n_t) reverses along its principal direction.
+
+    The motion's largest excursion along the principal axis of its (centred) samples: a
+    reversal point for 1D paths and the end of the major axis for elliptical 2D paths, where
+    a march started from rest is on (or next to) its steady loop.
+    """
+    c = ut - ut.mean(axis=0)
+    if c.shape[1] == 1:
+        return int(np.argmax(c[:, 0]))
+    _, vecs = np.linalg.eigh(c.T @ c)
+    return int(np.argmax(c @ vecs[:, -1]))
+
+
 def require_keys(spec: dict, allowed, required, where: str) -> None:
     """Reject unknown keys by name, and name missing required ones."""
     unknown = [k for k in spec if k not in allowed]

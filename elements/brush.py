@@ -59,7 +59,8 @@ import math
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative, finite
+from .base import (Element, coordinate_rows, require_keys, positive, non_negative, finite,
+                   principal_reversal)
 from .hertz import hertz_contact
 
 
@@ -234,13 +235,8 @@ class Brush(Element):
         return cls(G, names, kn=kn, kt=kt, **geo)
 
     def start_index(self, u):
-        """Reversal of the tangential motion along its principal direction (as friction3d)."""
-        ut = np.asarray(u)[:, :self.n_tangential]
-        c = ut - ut.mean(axis=0)
-        if self.n_tangential == 1:
-            return int(np.argmax(c[:, 0]))
-        _, vecs = np.linalg.eigh(c.T @ c)
-        return int(np.argmax(c @ vecs[:, -1]))
+        """Reversal of the tangential motion along its principal direction."""
+        return principal_reversal(np.asarray(u)[:, :self.n_tangential])
 
     def march(self, z, dz):
         f, df, _ = self.march_counts(z, dz)

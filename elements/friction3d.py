@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative
+from .base import Element, coordinate_rows, require_keys, positive, non_negative, principal_reversal
 from .kinds import FRICTION3D
 
 
@@ -109,12 +109,8 @@ class Friction3D(Element):
         return float(self.params[3])
 
     def start_index(self, u):
-        ut = np.asarray(u)[:, :self.n_tangential]
-        c = ut - ut.mean(axis=0)
-        if self.n_tangential == 1:
-            return int(np.argmax(c[:, 0]))
-        _, vecs = np.linalg.eigh(c.T @ c)
-        return int(np.argmax(c @ vecs[:, -1]))
+        """Reversal of the tangential motion along its principal direction."""
+        return principal_reversal(np.asarray(u)[:, :self.n_tangential])
 
     def march(self, z, dz):
         """Forces and seeded derivatives over one period, loop closed by Newton (see class doc)."""
