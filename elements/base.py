@@ -8,8 +8,42 @@ motion as ``G^T f``.  The element holds parameters only (no history): its law is
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
+
+
+@dataclass(frozen=True)
+class LawSpec:
+    """What :func:`elements.law_march.march_law` needs to march one law (see that module).
+
+    Attributes
+    ----------
+    kind : int
+        Law id (:mod:`elements.kinds`).
+    params : ndarray, shape (n_p,)
+    n_state : int
+    closure : int
+        ``CLOSE_PLAIN`` (repeat periods) or ``CLOSE_NEWTON`` (Newton on the start state).
+    start_rule : int
+        ``START_FIRST``, ``START_ARGMAX`` or ``START_PRINCIPAL``.
+    n_start : int
+        Columns the start rule looks at.
+    max_passes : int
+    tol : float
+    velocity : bool
+        The law reads velocities (inputs ``[u, du/dt]``).
+    """
+
+    kind: int
+    params: np.ndarray
+    n_state: int
+    closure: int
+    start_rule: int
+    n_start: int
+    max_passes: int
+    tol: float
+    velocity: bool
 
 
 class Element:
@@ -58,9 +92,29 @@ class Element:
         """Inputs per sample: displacements, plus velocities for rate-dependent laws."""
         return self.n_local * (2 if self.velocity else 1)
 
+    start_rule: int = 0         # elements.law_march.START_* (for law elements)
+    closure: int = 0            # elements.law_march.CLOSE_* (for law elements)
+
+    def law_spec(self):
+        """The :class:`LawSpec` of a law element, or None if the element marches otherwise."""
+        return LawSpec(self.kind, self.params, self.n_state, self.closure, self.start_rule,
+                       self.n_start, self.max_passes, self.closure_tol, self.velocity)
+
+    def law_parts(self):
+        """``[(rows, LawSpec), ...]``: local rows marched by one law each, or None if the element
+        marches otherwise (then only :meth:`march` is used)."""
+        spec = self.law_spec()
+        return None if spec is None else [(np.arange(self.n_local), spec)]
+
+    @property
+    def n_start(self) -> int:
+        """Columns of ``u`` the start rule looks at (all local coordinates by default)."""
+        return self.n_local
+
     def start_index(self, u: np.ndarray) -> int:
         """Sample (a reversal point) where the march starts; ``u`` has shape (N, n_local)."""
-        raise NotImplementedError
+        from .law_march import start_sample
+        return int(start_sample(self.start_rule, self.n_start, np.ascontiguousarray(u, dtype=float)))
 
     def march(self, z: np.ndarray, dz: np.ndarray):
         """Forces and seeded derivatives over one period.
@@ -77,11 +131,11 @@ class Element:
         f : ndarray, shape (N, n_local)
         df : ndarray, shape (N, n_local, P)
         """
-        from .kernels import march
-        f, df, passes = march(self.kind, self.params, self.n_state, self.n_local,
-                              np.ascontiguousarray(z), np.ascontiguousarray(dz),
-                              self.start_index(z[:, :self.n_local]), self.max_passes,
-                              self.closure_tol)
+        from .law_march import march_law
+        f, df, passes = march_law(self.kind, self.params, self.n_state, self.n_local, self.closure,
+                                  self.start_index(z[:, :self.n_local]),
+                                  np.ascontiguousarray(z, dtype=float), np.ascontiguousarray(dz, dtype=float),
+                                  self.max_passes, self.closure_tol)
         return f, df
 
     def linear_stiffness(self) -> np.ndarray:
@@ -146,11 +200,9 @@ def principal_reversal(ut: np.ndarray) -> int:
     reversal point for 1D paths and the end of the major axis for elliptical 2D paths, where
     a march started from rest is on (or next to) its steady loop.
     """
-    c = ut - ut.mean(axis=0)
-    if c.shape[1] == 1:
-        return int(np.argmax(c[:, 0]))
-    _, vecs = np.linalg.eigh(c.T @ c)
-    return int(np.argmax(c @ vecs[:, -1]))
+    from .law_march import principal_reversal_index
+    ut = np.ascontiguousarray(ut, dtype=float)
+    return int(principal_reversal_index(ut, ut.shape[1]))
 
 
 def require_keys(spec: dict, allowed, required, where: str) -> None:

@@ -238,6 +238,9 @@ class Brush(Element):
         """Reversal of the tangential motion along its principal direction."""
         return principal_reversal(np.asarray(u)[:, :self.n_tangential])
 
+    def law_spec(self):
+        return None     # one kernel over all bristles (march_counts), not a single law
+
     def march(self, z, dz):
         f, df, _ = self.march_counts(z, dz)
         return f, df

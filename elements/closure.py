@@ -36,7 +36,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .kernels import law_step, law_init, _accumulate
+from .kernels import law_step, law_init, _accumulate, _propagate
 
 
 @nb.njit(cache=True)
@@ -55,8 +55,10 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     Ms_new = np.zeros((ns, ns))
     A = np.zeros((ns, ns))
     B = np.zeros((ns, nz))
-    law_init(kind, p, z[start], s, B)
-    _accumulate(B, dz[start], ds)
+    zj = np.empty(nz)
+    zj[:] = z[start]
+    law_init(kind, p, zj, s, B)
+    _propagate(A, B, ds_new, dz, start, ds)     # A = 0 here: ds = C0 dz[start]
     f = np.empty((N, n_local))
     df = np.empty((N, n_local, P))
     passes = 0
@@ -72,10 +74,10 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
         Ms[:, :] = eye
         for jj in range(1, N + 1):
             j = (start + jj) % N
-            law_step(kind, p, s, z[j], s_new, A, B)
-            ds_new[:, :] = 0.0
-            _accumulate(A, ds, ds_new)
-            _accumulate(B, dz[j], ds_new)
+            for k in range(nz):
+                zj[k] = z[j, k]
+            law_step(kind, p, s, zj, s_new, A, B)
+            _propagate(A, B, ds, dz, j, ds_new)
             Ms_new[:, :] = 0.0
             _accumulate(A, Ms, Ms_new)
             s, s_new = s_new, s

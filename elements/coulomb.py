@@ -6,6 +6,7 @@ import numpy as np
 from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
 from .kinds import COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
 from .laws.coulomb import LINEAR, ARCTAN
+from .law_march import START_ARGMAX
 
 
 class CoulombStickSlip(Element):
@@ -22,6 +23,7 @@ class CoulombStickSlip(Element):
     """
 
     kind = COULOMB_STATIC_KINETIC
+    start_rule = START_ARGMAX
     n_state = 3
     velocity = False
     needs_mean = False
@@ -43,9 +45,6 @@ class CoulombStickSlip(Element):
         G = coordinate_rows([spec["dofs"]], n_dof, dof_index, where)
         return cls(G, spec["kt"], spec["normal_load"], spec["mu_static"], spec["mu_kinetic"],
                    spec.get("name", "coulomb_stick_slip"))
-
-    def start_index(self, u):
-        return int(np.argmax(u[:, 0]))
 
     def linear_stiffness(self):
         stuck = self.params[1] * self.params[2] > 0.0
@@ -88,9 +87,6 @@ class CoulombRegularised(Element):
         G = coordinate_rows([spec["dofs"]], n_dof, dof_index, where)
         return cls(G, spec["slip_force"], spec["v_r"], spec.get("law", "linear"),
                    spec.get("name", "coulomb_regularised"))
-
-    def start_index(self, u):
-        return 0
 
     def linear_stiffness(self):
         return np.zeros((1, 1))

@@ -26,8 +26,5 @@ class Cubic(Element):
         G = coordinate_rows([spec["dofs"]], n_dof, dof_index, where)
         return cls(G, spec["k3"], spec.get("name", "cubic"))
 
-    def start_index(self, u):
-        return 0
-
     def linear_stiffness(self):
         return np.zeros((1, 1))

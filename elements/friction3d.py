@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative, principal_reversal
+from .base import Element, coordinate_rows, require_keys, positive, non_negative
+from .law_march import START_PRINCIPAL, CLOSE_NEWTON
 from .kinds import FRICTION3D
 
 
@@ -61,6 +62,8 @@ class Friction3D(Element):
                   "dissipation")
     max_passes = 1000
     closure_tol = 1e-12
+    start_rule = START_PRINCIPAL
+    closure = CLOSE_NEWTON
 
     def __init__(self, gather, kt, kn, mu, normal_preload, name="friction3d"):
         G = np.array(gather, dtype=float, ndmin=2)
@@ -108,19 +111,9 @@ class Friction3D(Element):
     def normal_preload(self):
         return float(self.params[3])
 
-    def start_index(self, u):
-        """Reversal of the tangential motion along its principal direction."""
-        return principal_reversal(np.asarray(u)[:, :self.n_tangential])
-
-    def march(self, z, dz):
-        """Forces and seeded derivatives over one period, loop closed by Newton (see class doc)."""
-        from .closure import march_newton
-        f, df, passes = march_newton(self.kind, self.params, self.n_state, self.n_local,
-                                     np.ascontiguousarray(z, dtype=float),
-                                     np.ascontiguousarray(dz, dtype=float),
-                                     self.start_index(np.asarray(z)[:, :self.n_local]),
-                                     self.max_passes, self.closure_tol)
-        return f, df
+    @property
+    def n_start(self) -> int:
+        return self.n_tangential
 
     def linear_stiffness(self):
         """Tangent at rest: ``kn`` along n (closing side), ``kt`` along t1, t2 if ``mu N0 > 0``."""

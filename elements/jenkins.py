@@ -5,6 +5,7 @@ import numpy as np
 
 from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
 from .kinds import JENKINS
+from .law_march import START_ARGMAX
 
 
 class Jenkins(Element):
@@ -27,6 +28,8 @@ class Jenkins(Element):
     coord_names = ("u",)
     keys = ("type", "dofs", "kt", "slip_force", "name")
     quantities = ("slip_fraction", "force_amplitude", "dissipation")
+    # a displacement maximum is a reversal point: the loop is closed after one pass
+    start_rule = START_ARGMAX
 
     def __init__(self, gather, kt, slip_force, name="jenkins"):
         super().__init__(gather, np.array([positive("kt", kt), non_negative("slip_force", slip_force)]), name)
@@ -44,10 +47,6 @@ class Jenkins(Element):
     @property
     def slip_force(self):
         return float(self.params[1])
-
-    def start_index(self, u):
-        # a displacement maximum is a reversal point: the loop is closed after one pass
-        return int(np.argmax(u[:, 0]))
 
     def linear_stiffness(self):
         return np.array([[self.kt]])

@@ -30,7 +30,7 @@ from .laws.friction3d import friction3d_step, friction3d_init
 from .laws.coulomb import coulomb_sk_step, coulomb_sk_init, coulomb_reg_step, coulomb_reg_init
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def law_step(kind, p, s, z, s_new, A, B):
     """Dispatch one incremental update to the law ``kind`` (see module docstring)."""
     if kind == JENKINS:
@@ -47,7 +47,7 @@ def law_step(kind, p, s, z, s_new, A, B):
         raise ValueError("unknown law kind")
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def law_init(kind, p, z0, s0, C0):
     """Rest state ``s0`` at input ``z0`` reached from ``q = 0``, and ``C0 = ds0/dz0``."""
     if kind == JENKINS:
@@ -64,7 +64,7 @@ def law_init(kind, p, z0, s0, C0):
         raise ValueError("unknown law kind")
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _accumulate(M, X, out):
     """``out += M @ X`` skipping zero entries of the small matrix ``M``."""
     for i in range(M.shape[0]):
@@ -75,35 +75,24 @@ def _accumulate(M, X, out):
                     out[i, c] += m * X[k, c]
 
 
-@nb.njit(cache=True)
-def _propagate(A, B, ds, dzj, out):
-    """``out = A @ ds + B @ dzj`` skipping zero entries of the small matrices ``A``, ``B``."""
+@nb.njit(cache=True, inline="always")
+def _propagate(A, B, ds, dz, j, out):
+    """``out = A @ ds + B @ dz[j]`` skipping zero entries of the small matrices ``A``, ``B``
+    (``dz`` indexed in place: no per-sample view)."""
     P = ds.shape[1]
     for i in range(A.shape[0]):
-        first = True
+        for c in range(P):
+            out[i, c] = 0.0
         for k in range(A.shape[1]):
             m = A[i, k]
             if m != 0.0:
-                if first:
-                    for c in range(P):
-                        out[i, c] = m * ds[k, c]
-                    first = False
-                else:
-                    for c in range(P):
-                        out[i, c] += m * ds[k, c]
+                for c in range(P):
+                    out[i, c] += m * ds[k, c]
         for k in range(B.shape[1]):
             m = B[i, k]
             if m != 0.0:
-                if first:
-                    for c in range(P):
-                        out[i, c] = m * dzj[k, c]
-                    first = False
-                else:
-                    for c in range(P):
-                        out[i, c] += m * dzj[k, c]
-        if first:
-            for c in range(P):
-                out[i, c] = 0.0
+                for c in range(P):
+                    out[i, c] += m * dz[j, k, c]
 
 
 @nb.njit(cache=True)
@@ -145,8 +134,11 @@ def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     ds_new = np.zeros((n_state, P))
     A = np.zeros((n_state, n_state))
     B = np.zeros((n_state, nz))
-    law_init(kind, p, z[start], s, B)
-    _accumulate(B, dz[start], ds)
+    zj = np.empty(nz)
+    zj[:] = z[start]
+    law_init(kind, p, zj, s, B)
+    _propagate(A, B, ds, dz, start, ds_new)      # A = 0 here: ds = C0 dz[start]
+    ds, ds_new = ds_new, ds
     f = np.empty((N, n_local))
     df = np.empty((N, n_local, P))
     passes = 0
@@ -158,8 +150,10 @@ def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
             j = start + jj
             if j >= N:
                 j -= N
-            law_step(kind, p, s, z[j], s_new, A, B)
-            _propagate(A, B, ds, dz[j], ds_new)
+            for k in range(nz):
+                zj[k] = z[j, k]
+            law_step(kind, p, s, zj, s_new, A, B)
+            _propagate(A, B, ds, dz, j, ds_new)
             s, s_new = s_new, s
             ds, ds_new = ds_new, ds
             for a in range(n_local):

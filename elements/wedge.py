@@ -207,6 +207,14 @@ class WedgeDamper(Element):
     def start_index(self, u):
         raise NotImplementedError("wedge_damper marches its contacts one by one (see march)")
 
+    def law_spec(self):
+        return None
+
+    def law_parts(self):
+        """Each contact's rows and friction3d law (the AFT marches them one by one)."""
+        return [(np.arange(self._rows(k).start, self._rows(k).stop), c.law_spec())
+                for k, c in enumerate(self.contacts)]
+
     def linear_stiffness(self):
         """Block diagonal of the contacts' stuck, closed tangents, (n_local, n_local)."""
         K = np.zeros((self.n_local, self.n_local))

@@ -38,40 +38,47 @@ from __future__ import annotations
 import math
 
 import numba as nb
-import numpy as np
 
 
-@nb.njit(cache=True)
-def _tangential(kt, mu, Nload, kn, ft_trial, nt, s_new, J, G):
-    """Return mapping of a trial force: writes ``s_new[:nt]``, ``J = df_t/df_trial`` (nt, nt)
-    and ``G = df_t/du_n`` (nt,); returns True if slipping."""
-    limit = mu * Nload
-    g2 = 0.0
-    for a in range(nt):
-        g2 += ft_trial[a] * ft_trial[a]
-    g = math.sqrt(g2)
-    for a in range(nt):
-        G[a] = 0.0
-        for b in range(nt):
-            J[a, b] = 0.0
+@nb.njit(cache=True, inline="always")
+def _radial_return(limit, t0, t1):
+    """Return mapping of the trial force ``(t0, t1)`` (``t1 = 0`` for one direction) onto the
+    circle of radius ``limit``: ``(f0, f1, r, d0, d1, slipping)`` with ``d = f^{tr}/|f^{tr}|``
+    and ``r = limit / |f^{tr}|`` (``r = 1``, ``d = 0`` while sticking)."""
+    g = math.sqrt(t0 * t0 + t1 * t1)
     if g <= limit:
-        for a in range(nt):
-            s_new[a] = ft_trial[a]
-            J[a, a] = 1.0
-        return False
-    # g > limit >= 0, so g > 0: radial return onto the circle of radius mu N
+        return t0, t1, 1.0, 0.0, 0.0, False
+    # g > limit >= 0, so g > 0
     r = limit / g
+    d0 = t0 / g
+    d1 = t1 / g
+    return limit * d0, limit * d1, r, d0, d1, True
+
+
+@nb.njit(cache=True, inline="always")
+def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, with_A):
+    """Tangential forces into ``s_new`` and their derivatives (module doc) into ``A``
+    (if ``with_A``: ``df_t/df_prev = J``, ``df_t/du_prev = -kt J``) and ``B``
+    (``df_t/du_t = kt J``, ``df_t/du_n = mu kn d``), ``J = r (I - d d^T)`` or ``I``."""
+    s_new[0] = f0
+    if nt == 2:
+        s_new[1] = f1
     for a in range(nt):
-        da = ft_trial[a] / g
-        s_new[a] = limit * da
-        G[a] = mu * kn * da
+        da = d0 if a == 0 else d1
         for b in range(nt):
-            db = ft_trial[b] / g
-            J[a, b] = r * ((1.0 if a == b else 0.0) - da * db)
-    return True
+            db = d0 if b == 0 else d1
+            if slipping:
+                J = r * ((1.0 if a == b else 0.0) - da * db)
+            else:
+                J = 1.0 if a == b else 0.0
+            if with_A:
+                A[a, b] = J
+                A[a, w0 + b] = -kt * J
+            B[a, b] = kt * J
+        B[a, nt] = mu * kn * da if slipping else 0.0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def friction3d_step(p, s, z, s_new, A, B):
     """One return-mapping step; ``A = ds_new/ds`` (ns, ns), ``B = ds_new/dz`` (ns, nt + 1)."""
     kt = p[0]
@@ -95,21 +102,13 @@ def friction3d_step(p, s, z, s_new, A, B):
         return
     s_new[n_row] = kn * un
     B[n_row, nt] = kn
-    ft_trial = np.empty(nt)
-    for a in range(nt):
-        ft_trial[a] = s[a] + kt * (z[a] - s[w0 + a])
-    J = np.empty((nt, nt))
-    G = np.empty(nt)
-    _tangential(kt, mu, Nload, kn, ft_trial, nt, s_new, J, G)
-    for a in range(nt):
-        for b in range(nt):
-            A[a, b] = J[a, b]
-            A[a, w0 + b] = -kt * J[a, b]
-            B[a, b] = kt * J[a, b]
-        B[a, nt] = G[a]
+    t0 = s[0] + kt * (z[0] - s[w0])
+    t1 = s[1] + kt * (z[1] - s[w0 + 1]) if nt == 2 else 0.0
+    f0, f1, r, d0, d1, slipping = _radial_return(mu * Nload, t0, t1)
+    _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, True)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def friction3d_init(p, z0, s0, C0):
     """Rest state reached at ``z0`` from ``q = 0`` without reversal, ``C0 = ds0/dz0``.
 
@@ -136,14 +135,6 @@ def friction3d_init(p, z0, s0, C0):
         return
     s0[n_row] = kn * un
     C0[n_row, nt] = kn
-    ft_trial = np.empty(nt)
-    for a in range(nt):
-        ft_trial[a] = kt * z0[a]
-    J = np.empty((nt, nt))
-    G = np.empty(nt)
-    _tangential(kt, mu, Nload, kn, ft_trial, nt, s0, J, G)
-    for a in range(nt):
-        for b in range(nt):
-            C0[a, b] = kt * J[a, b]
-        C0[a, nt] = G[a]
-
+    t1 = kt * z0[1] if nt == 2 else 0.0
+    f0, f1, r, d0, d1, slipping = _radial_return(mu * Nload, kt * z0[0], t1)
+    _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s0, C0, C0, False)

@@ -1,0 +1,164 @@
+r"""One seeded march of a law over a period: start sample, linear shortcut and loop closure.
+
+A law element (:class:`elements.base.LawSpec`) is marched from the rest state at a start
+sample ``j0`` chosen by a rule on the sampled coordinates ``u`` (N, n):
+
+- ``START_FIRST``: ``j0 = 0`` (memoryless laws);
+- ``START_ARGMAX``: ``j0 = argmax_j u_{j,0}`` (a reversal of a 1D motion);
+- ``START_PRINCIPAL``: the reversal along the principal direction ``v`` of the centred
+  tangential samples ``c_j = u_j - \bar u`` (first ``n_start`` columns),
+  ``j0 = argmax_j c_j \cdot v`` with ``v`` the leading eigenvector of ``C = \sum_j c_j c_j^T``
+  (closed form for 2 x 2; sign fixed so that its largest component is positive).
+
+Before marching, a law may recognise a period on which it is linear at every sample:
+
+.. math::
+
+    f_j = f_0 + K z_j \quad (j = 1 \dots N)
+
+(a Jenkins slider or a closed friction contact that never slips: ``K = k_t``, ``f_0 = 0``;
+an open contact: ``K = 0``, ``f_0 = [0, -N_0]``).  The march from the rest state gives exactly
+that (to round-off), so the caller may skip marching and transforming.
+"""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .kinds import JENKINS, FRICTION3D
+from .kernels import march
+from .closure import march_newton
+
+START_FIRST = 0
+START_ARGMAX = 1
+START_PRINCIPAL = 2
+
+CLOSE_PLAIN = 0
+CLOSE_NEWTON = 1
+
+
+@nb.njit(cache=True)
+def principal_reversal_index(u, n):
+    """Reversal sample of the first ``n`` (1 or 2; more: LAPACK) columns of ``u`` (N, >= n)."""
+    N = u.shape[0]
+    if n == 1:
+        return int(np.argmax(u[:, 0]))
+    mean = np.zeros(n)
+    for j in range(N):
+        for a in range(n):
+            mean[a] += u[j, a]
+    mean /= N
+    v = np.zeros(n)
+    if n == 2:
+        a11 = 0.0
+        a12 = 0.0
+        a22 = 0.0
+        for j in range(N):
+            c0 = u[j, 0] - mean[0]
+            c1 = u[j, 1] - mean[1]
+            a11 += c0 * c0
+            a12 += c0 * c1
+            a22 += c1 * c1
+        half = 0.5 * (a11 - a22)
+        r = math.sqrt(half * half + a12 * a12)
+        if half >= 0.0:
+            v[0] = half + r
+            v[1] = a12
+        else:
+            v[0] = a12
+            v[1] = r - half
+        if v[0] == 0.0 and v[1] == 0.0:
+            v[0] = 1.0
+    else:
+        C = np.zeros((n, n))
+        for j in range(N):
+            for a in range(n):
+                for b in range(n):
+                    C[a, b] += (u[j, a] - mean[a]) * (u[j, b] - mean[b])
+        _, vecs = np.linalg.eigh(C)
+        v[:] = vecs[:, n - 1]
+    big = 0
+    for a in range(n):
+        if abs(v[a]) > abs(v[big]):
+            big = a
+    sign = 1.0 if v[big] >= 0.0 else -1.0
+    best = -np.inf
+    j0 = 0
+    for j in range(N):
+        proj = 0.0
+        for a in range(n):
+            proj += (u[j, a] - mean[a]) * v[a]
+        proj *= sign
+        if proj > best:
+            best = proj
+            j0 = j
+    return j0
+
+
+@nb.njit(cache=True)
+def start_sample(rule, n_start, u):
+    """Start sample of the march by ``rule`` (module doc) on ``u`` (N, >= n_start)."""
+    if rule == START_ARGMAX:
+        return int(np.argmax(u[:, 0]))
+    if rule == START_PRINCIPAL:
+        return principal_reversal_index(u, n_start)
+    return 0
+
+
+@nb.njit(cache=True)
+def linear_shortcut(kind, p, z, K, f0):
+    """True if the law is linear, ``f = f0 + K z``, at every sample of ``z`` (N, nz).
+
+    Writes ``K`` (n_local, nz) and ``f0`` (n_local,) when it returns True.
+    """
+    N = z.shape[0]
+    if kind == JENKINS:
+        kt = p[0]
+        fs = p[1]
+        for j in range(N):
+            if abs(kt * z[j, 0]) > fs:
+                return False
+        K[0, 0] = kt
+        f0[0] = 0.0
+        return True
+    if kind == FRICTION3D:
+        kt = p[0]
+        kn = p[1]
+        mu = p[2]
+        N0 = p[3]
+        nt = int(p[4])
+        n_open = 0
+        for j in range(N):
+            Nload = N0 + kn * z[j, nt]
+            if Nload <= 0.0:
+                n_open += 1
+                continue
+            if n_open > 0:
+                return False
+            g2 = 0.0
+            for a in range(nt):
+                g2 += (kt * z[j, a]) ** 2
+            if math.sqrt(g2) > mu * Nload:
+                return False
+        K[:, :] = 0.0
+        f0[:] = 0.0
+        if n_open == N:
+            f0[nt] = -N0
+            return True
+        if n_open > 0:
+            return False
+        for a in range(nt):
+            K[a, a] = kt
+        K[nt, nt] = kn
+        return True
+    return False
+
+
+@nb.njit(cache=True)
+def march_law(kind, p, n_state, n_local, closure, start, z, dz, max_passes, tol):
+    """:func:`elements.kernels.march` or :func:`elements.closure.march_newton` by ``closure``."""
+    if closure == CLOSE_NEWTON:
+        return march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol)
+    return march(kind, p, n_state, n_local, z, dz, start, max_passes, tol)
