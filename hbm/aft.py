@@ -16,12 +16,15 @@ and the Jacobian follows from the same march with forward-mode seeds
     \frac{\partial F_{nl}}{\partial X_{nl}} = (I \otimes G^T)\, P\, \frac{\partial f}{\partial U}\,(I \otimes G),
 
 assembled by batched products with the small dense ``G`` (never as a Kronecker product).
-Only the DOFs touched by an element (the nonlinear DOFs) enter the AFT.
+Only the DOFs touched by an element (the nonlinear DOFs) enter the AFT.  Law elements on the
+DFT-matrix transform take the fused numba path of :mod:`hbm.aft_kernel` (same numbers, one
+call per law, linear periods without a march).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from .aft_kernel import aft_law, aft_law_forces
 from .fourier import FourierBasis
 
 
@@ -67,7 +70,21 @@ class NonlinearForces:
         self._G = [np.ascontiguousarray(e.gather[:, self.dofs]) for e in self.elements]
         self._seed_u = {}
         self._seed_v = {}
-        for e in self.elements:
+        # fused path: (G rows of the law, LawSpec) per law part, or None for a generic element
+        fused = getattr(transform, "name", "") == "dft"
+        self._parts = []
+        for e, G in zip(self.elements, self._G):
+            parts = e.law_parts() if fused else None
+            self._parts.append(None if parts is None else
+                               [(np.ascontiguousarray(G[rows]), spec) for rows, spec in parts])
+        rows0 = np.flatnonzero(basis.h_of_row == 0)
+        self._row0 = int(rows0[0]) if rows0.size else -1
+        self._E = np.ascontiguousarray(basis.E)
+        self._dE = np.ascontiguousarray(basis.dE)
+        self._P = np.ascontiguousarray(basis.P)
+        for e, parts in zip(self.elements, self._parts):
+            if parts is not None:
+                continue
             nl = e.n_local
             if nl not in self._seed_u:
                 self._seed_u[nl] = _seeds(basis, nl, dE=False)
@@ -103,13 +120,20 @@ class NonlinearForces:
             Harmonic-major, consistent with ``Xnl.ravel()``.
         dFdw : ndarray, shape (n_coef, n_nl)
         """
+        Xnl = np.ascontiguousarray(Xnl, dtype=float)
         nc = self.basis.n_coef
         nn = self.n_nl
         F = np.zeros((nc, nn))
         J4 = np.zeros((nc, nn, nc, nn))
         dFdw = np.zeros((nc, nn))
         N = self.basis.n_samples
-        for e, G in zip(self.elements, self._G):
+        for e, G, parts in zip(self.elements, self._G, self._parts):
+            if parts is not None:
+                for Gp, sp in parts:
+                    aft_law(sp.kind, sp.params, sp.n_state, sp.closure, sp.start_rule, sp.n_start,
+                            sp.velocity, sp.max_passes, sp.tol, Gp, Xnl, w, self._E, self._dE,
+                            self._P, self._row0, F, J4, dFdw)
+                continue
             nl = e.n_local
             U = Xnl @ G.T
             u = self.transform.synthesize(U)
@@ -136,8 +160,17 @@ class NonlinearForces:
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:
         """Forces only, (n_coef, n_nl): the march runs with a single zero seed."""
+        Xnl = np.ascontiguousarray(Xnl, dtype=float)
         F = np.zeros((self.basis.n_coef, self.n_nl))
-        for i, (z, f) in enumerate(self.element_forces(Xnl, w)):
+        for i, parts in enumerate(self._parts):
+            if parts is not None:
+                for Gp, sp in parts:
+                    aft_law_forces(sp.kind, sp.params, sp.n_state, sp.closure, sp.start_rule,
+                                   sp.n_start, sp.velocity, sp.max_passes, sp.tol, Gp, Xnl, w,
+                                   self._E, self._dE, self._P, self._row0, F)
+                continue
+            z = self.element_samples(Xnl, w, i)
+            f, _ = self.elements[i].march(z, np.zeros(z.shape + (1,)))
             F += self.transform.analyse(f) @ self._G[i]
         return F
 
