@@ -332,7 +332,11 @@ class Arclength:
         if not sphere and not on_bound and jump > o.max_correction * ds:
             return (c, None, 0.0,
                     f"the corrector moved {jump / ds:.2g} step lengths (branch jump)", on_bound)
-        t_new = null_tangent(c.ev.Js, t)
+        if c.null is not None and not sphere and not on_bound and np.isfinite(c.null).all() \
+                and np.any(c.null):
+            t_new = c.null / np.linalg.norm(c.null)    # the hyperplane's a is t: same system
+        else:
+            t_new = null_tangent(c.ev.Js, t)
         if t_new @ chord < 0:
             t_new = -t_new
         cosang = float(np.clip(t_new @ t, -1.0, 1.0))

@@ -41,7 +41,9 @@ accepted when its residual is within ``stall_factor * tol`` (default 10).
 Polishing: at convergence the Newton matrix at the last evaluation is already at hand, so one
 more update :math:`\delta` is solved and applied without calling the function again; by
 quadratic convergence the returned point is then accurate to about :math:`tol^2`, i.e. to
-round-off (the reported residual is the one before this update).
+round-off (the reported residual is the one before this update).  The same solve, with the
+second right-hand side :math:`[0; \rho]`, gives the null vector of :math:`J_s` that fixes the
+tangent when :math:`a` is the previous tangent.
 """
 from __future__ import annotations
 
@@ -71,14 +73,21 @@ class Evaluation:
     R: np.ndarray
     Js: np.ndarray
 
+    def __post_init__(self):
+        # one pass over Js gives both: a NaN or inf entry makes its row sum and the
+        # maximum NaN or inf (so does an overflowing sum, which is no usable Jacobian either)
+        norm = float(np.abs(self.Js).sum(axis=1).max(initial=0.0))
+        self._finite = bool(np.isfinite(norm) and np.isfinite(self.R).all())
+        self._row_norm = norm if self._finite else 0.0
+
     @property
     def finite(self) -> bool:
         """Residual and Jacobian are free of NaN and inf."""
-        return bool(np.all(np.isfinite(self.R)) and np.all(np.isfinite(self.Js)))
+        return self._finite
 
     def row_norm(self) -> float:
         """``||Js||_inf`` (largest absolute row sum); 0 when not finite."""
-        return float(np.abs(self.Js).sum(axis=1).max(initial=0.0)) if self.finite else 0.0
+        return self._row_norm
 
 
 @dataclass
@@ -100,6 +109,11 @@ class Correction:
     xs : ndarray, shape (n+1,) or None
         The solution: ``ev.xs`` plus one last Newton update computed from ``ev`` without a
         further call of the function (module doc); ``None`` means ``ev.xs``.
+    null : ndarray, shape (n+1,) or None
+        When converged with a last update: ``v`` solving ``[Js; rho a^T] v = [0; rho]`` at
+        ``ev`` (``a`` the constraint gradient there), a null vector of ``Js`` normalised by
+        ``a @ v = 1``; for the arclength hyperplane (``a`` = the previous tangent) this is
+        the new tangent's direction (:func:`continuation.tangent.null_tangent`'s system).
     """
 
     converged: bool
@@ -108,6 +122,7 @@ class Correction:
     residual: float
     reason: str = ""
     xs: np.ndarray | None = None
+    null: np.ndarray | None = None
 
     def __post_init__(self):
         if self.xs is None:
@@ -184,8 +199,17 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         A[n] = rho * a
         rhs[:n] = -ev.R
         rhs[n] = -rho * g
+        null = None
         try:
-            delta = np.linalg.solve(A, rhs)
+            if converged:
+                # the same matrix also gives the null vector of Js (the tangent, module doc)
+                B = np.zeros((n + 1, 2))
+                B[:, 0] = rhs
+                B[n, 1] = rho
+                sol = np.linalg.solve(A, B)
+                delta, null = sol[:, 0], sol[:, 1]
+            else:
+                delta = np.linalg.solve(A, rhs)
         except np.linalg.LinAlgError:
             delta = None
         if delta is None or not np.all(np.isfinite(delta)):
@@ -194,7 +218,7 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
         if converged:
             # free polishing update: error ~ |delta|^2, no further call of the function
-            return Correction(True, ev, it, res, xs=ev.xs + delta)
+            return Correction(True, ev, it, res, xs=ev.xs + delta, null=null)
         if np.abs(delta).max() <= 16 * _EPS * size and res <= np.sqrt(tol):
             return Correction(True, ev, it, res)
         merit = max(res, abs(g))
