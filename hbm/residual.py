@@ -82,6 +82,31 @@ class HarmonicBalance:
                                 dtype=np.int64)
         self._rows_s = self._rows_c + 1
         self._h_c = h[self._rows_c].astype(float)
+        # small dense models: Z(w) = Z0 + w Z1 - w^2 Z2 from three matrices built once
+        self._templates = None
+        mats = (model.K, model.C, model.M)
+        if basis.n_coef * n <= self.TEMPLATE_MAX and all(isinstance(m, np.ndarray) for m in mats):
+            self._templates = tuple(self._block_matrix(*parts) for parts in
+                                    ((model.K, None, None), (None, model.C, None), (None, None, model.M)))
+
+    TEMPLATE_MAX = 600     # largest n_coef * n_dof for which Z0, Z1, Z2 are kept (3 n^2 floats)
+
+    def _block_matrix(self, K, C, M):
+        """Dense ``Z`` of one part (n_coef n, n_coef n): ``K`` per row, ``h C`` in the cosine-sine
+        blocks (``-h C`` sine-cosine), ``h^2 M`` per row; the others None."""
+        nc, n = self.basis.n_coef, self.n_dof
+        Z = np.zeros((nc * n, nc * n))
+        Z4 = Z.reshape(nc, n, nc, n)
+        r = self._rows
+        if K is not None:
+            Z4[r, :, r, :] = K[None]
+        if M is not None:
+            Z4[r, :, r, :] = self._h2[:, None, None] * M[None]
+        if C is not None and self._rows_c.size:
+            hC = self._h_c[:, None, None] * C[None]
+            Z4[self._rows_c, :, self._rows_s, :] = hC
+            Z4[self._rows_s, :, self._rows_c, :] = -hC
+        return Z
 
     @property
     def n_unknowns(self) -> int:
@@ -108,6 +133,19 @@ class HarmonicBalance:
         - w^2 h_r^2 M X_r`` (``D`` the derivative operator), evaluated for all rows at
         once; ``Z`` is filled harmonic block by harmonic block through a 4-D view.
         """
+        if self._templates is not None:
+            Z0, Z1, Z2 = self._templates
+            nc, n = X.shape
+            Zw = Z0 + w * Z1 - (w * w) * Z2
+            if out is None:
+                Z = Zw
+            else:
+                Z = out
+                Z[...] = Zw
+            x = X.reshape(-1)
+            z1, z2 = Z1 @ x, Z2 @ x
+            dZX = (z1 - (2.0 * w) * z2).reshape(nc, n)
+            return (Zw @ x).reshape(nc, n), Z, dZX
         M, C, K = self.model.M, self.model.C, self.model.K
         h2X = self._h2[:, None] * X
         DX = self.basis.D @ X
