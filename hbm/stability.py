@@ -113,17 +113,12 @@ class HillResult:
     stable: bool
 
 
-def _harmonic_rows(basis: FourierBasis):
-    """``[(h, row_c, row_s or None), ...]`` for the harmonics of ``basis``."""
-    out, r = [], 0
-    for h in basis.harmonics:
-        if h == 0:
-            out.append((0, r, None))
-            r += 1
-        else:
-            out.append((int(h), r, r + 1))
-            r += 2
-    return out
+def _pair_rows(basis: FourierBasis):
+    """Cosine rows ``rc`` (k,) of the harmonics ``h > 0`` (sine row ``rc + 1``), their
+    harmonics ``h`` (k,), and the row of harmonic 0 (``None`` if absent)."""
+    hr = basis.h_of_row
+    rc = np.flatnonzero(hr > 0)[::2]
+    return rc, hr[rc], (0 if hr[0] == 0 else None)
 
 
 def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis, w: float) -> np.ndarray:
@@ -142,7 +137,8 @@ def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis
     Returns
     -------
     A : ndarray, shape (2 n_u, 2 n_u)
-        ``[[0, I], [-D2^{-1} J, -D2^{-1} D1]]``.
+        ``[[0, I], [-D2^{-1} J, -D2^{-1} D1]]``, filled block by block through a 6-D view
+        (no loop over harmonics).
     """
     n = M.shape[0]
     nc = basis.n_coef
@@ -151,22 +147,19 @@ def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis
         raise ValueError(f"J must be ({nu}, {nu}) for {nc} coefficients x {n} dofs, got {J.shape}")
     Minv = np.linalg.inv(M)
     MinvC = Minv @ C
-    eye = np.eye(n)
     A = np.zeros((2 * nu, 2 * nu))
-    A[:nu, nu:] = np.eye(nu)
+    A6 = A.reshape(2, nc, n, 2, nc, n)
+    r = np.arange(nc)
+    A6[0, r, :, 1, r, :] = np.eye(n)
     # -D2^{-1} J: M^{-1} applied to every coefficient row-block of J
-    A[nu:, :nu] = -np.einsum("ab,kbl->kal", Minv, J.reshape(nc, n, nu)).reshape(nu, nu)
-    # -D2^{-1} D1, block diagonal per harmonic
-    B = A[nu:, nu:]
-    for h, rc, rs in _harmonic_rows(basis):
-        c = slice(rc * n, (rc + 1) * n)
-        B[c, c] = -MinvC
-        if rs is None:
-            continue
-        s = slice(rs * n, (rs + 1) * n)
-        B[s, s] = -MinvC
-        B[c, s] = -2.0 * h * w * eye
-        B[s, c] = 2.0 * h * w * eye
+    A6[1, :, :, 0, :, :] = -np.einsum("ab,kbl->kal", Minv, J.reshape(nc, n, nu)).reshape(nc, n, nc, n)
+    # -D2^{-1} D1, block diagonal per harmonic: -M^{-1} C on the diagonal, -+2 h w I coupling
+    A6[1, r, :, 1, r, :] = -MinvC
+    rc, h, _ = _pair_rows(basis)
+    if rc.size:
+        g = (2.0 * w * h)[:, None, None] * np.eye(n)[None]
+        A6[1, rc, :, 1, rc + 1, :] = -g
+        A6[1, rc + 1, :, 1, rc, :] = g
     return A
 
 
@@ -190,20 +183,18 @@ def complex_index_weights(P: np.ndarray, basis: FourierBasis, n: int):
     """
     m = P.shape[1]
     Pr = P.reshape(basis.n_coef, n, m)
-    idx, rows = [], []
-    for h, rc, rs in _harmonic_rows(basis):
-        if rs is None:
-            idx.append(0)
-            rows.append(np.sum(np.abs(Pr[rc]) ** 2, axis=0))
-        else:
-            cp = 0.5 * (Pr[rc] - 1j * Pr[rs])
-            cm = 0.5 * (Pr[rc] + 1j * Pr[rs])
-            idx += [h, -h]
-            rows += [np.sum(np.abs(cp) ** 2, axis=0), np.sum(np.abs(cm) ** 2, axis=0)]
-    W = np.array(rows)
+    rc, h, r0 = _pair_rows(basis)
+    cp = 0.5 * (Pr[rc] - 1j * Pr[rc + 1])              # (k, n, m): c_{+h}
+    cm = 0.5 * (Pr[rc] + 1j * Pr[rc + 1])              # c_{-h}
+    pairs = np.stack([np.sum(np.abs(cp) ** 2, axis=1), np.sum(np.abs(cm) ** 2, axis=1)], axis=1)
+    W = pairs.reshape(2 * rc.size, m)
+    idx = np.stack([h, -h], axis=1).reshape(-1)
+    if r0 is not None:
+        W = np.concatenate([np.sum(np.abs(Pr[r0]) ** 2, axis=0)[None], W])
+        idx = np.r_[0, idx]
     tot = W.sum(axis=0)
     W = W / np.where(tot > 0, tot, 1.0)
-    return np.array(idx, dtype=np.int64), W
+    return idx.astype(np.int64), W
 
 
 def fold_exponents(lam: np.ndarray, w: float) -> np.ndarray:
