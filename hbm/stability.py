@@ -58,6 +58,14 @@ of one root are spuriously unstable, a known defect of hysteretic damping in the
 
 The solution is asymptotically stable when :math:`\max \mathrm{Re}\,\lambda < \tau w`
 with a small relative tolerance :math:`\tau` (:class:`StabilityOptions`).
+
+**Verdict without eigenvectors** (:func:`hill_is_stable`, used along an FRF).  Only the
+choice among more than ``2n`` in-strip eigenvalues needs the eigenvectors; with ``m``
+eigenvalues in the strip of which ``b`` are unstable, the verdict is *stable* when ``b = 0``
+and *unstable* when ``b > m - 2n`` (some unstable one must be kept), whatever the choice;
+with ``m < 2n`` the fill-ins are chosen by ``|Im|`` alone.  Only ``0 < b <= m - 2n`` needs
+the vectors (the full :func:`hill_stability`).  The eigenvalues come from the same LAPACK
+``geev`` reduction and QR iteration with and without vectors, so the verdict is the same.
 """
 from __future__ import annotations
 
@@ -261,6 +269,86 @@ def hill_stability(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBa
     ex = ex[np.argsort(-ex.real, kind="stable")]
     max_real = float(ex.real.max())
     return HillResult(ex, lam, mean_index, max_real, bool(max_real < opts.rel_tol * w))
+
+
+def verdict_from_eigenvalues(hill_eigenvalues: np.ndarray, n: int, w: float, rel_tol: float):
+    """The verdict of :func:`hill_stability` decided from the Hill eigenvalues alone.
+
+    The filter (:func:`select_exponents`) needs eigenvectors only to choose among more than
+    ``2 n`` in-strip eigenvalues; the verdict does not depend on that choice when no in-strip
+    eigenvalue is unstable (``Re >= rel_tol * w``), or when there are more unstable ones
+    than can be left out.  With fewer than ``2 n`` in the strip every in-strip eigenvalue is
+    kept and the fill-ins are chosen by ``|Im|`` alone.
+
+    Parameters
+    ----------
+    hill_eigenvalues : ndarray of complex, shape (m,)
+        All eigenvalues of the truncated Hill problem, in the order LAPACK returns them
+        (it breaks ties of the fill-in order, as in :func:`select_exponents`).
+    n : int
+        Number of DOFs.
+    w : float
+        Angular frequency, rad/s.
+    rel_tol : float
+        :attr:`StabilityOptions.rel_tol`.
+
+    Returns
+    -------
+    bool or None
+        ``HillResult.stable`` of the same eigenvalues, or ``None`` when it depends on the
+        eigenvectors (or on how a tie in the fill-in order is broken).
+    """
+    lam = hill_eigenvalues
+    k = min(2 * n, lam.size)
+    im = lam.imag
+    inside = (im > -0.5 * w) & (im <= 0.5 * w)
+    bad = ~(lam.real < rel_tol * w)                  # fails max_real < rel_tol * w
+    m_in = int(inside.sum())
+    bad_in = int((bad & inside).sum())
+    if m_in >= k:
+        # the kept ones are k of the m_in in-strip eigenvalues
+        if bad_in == 0:
+            return True
+        return False if bad_in > m_in - k else None
+    if bad_in:
+        return False
+    # every in-strip one is kept, plus the first k - m_in outside in select_exponents' order
+    out = np.flatnonzero(~inside)
+    key = np.round(np.abs(im[out]) / w, 9)
+    order = np.lexsort((out, key))
+    n_fill = k - m_in
+    last = key[order[n_fill - 1]]
+    tie = key == last
+    if np.any(bad[out[tie]]) and not np.all(bad[out[tie]]):
+        return None                                  # the choice inside a tie decides
+    return not np.any(bad[out[order[:n_fill]]])
+
+
+def hill_is_stable(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis, w: float,
+                   options: StabilityOptions | None = None) -> bool:
+    """``hill_stability(J, M, C, basis, w, options).stable``, computed without eigenvectors
+    whenever :func:`verdict_from_eigenvalues` can decide it (parameters as there).
+
+    LAPACK's ``geev`` runs the same reduction and QR iteration with and without vectors, so
+    the eigenvalues are those :func:`hill_stability` filters; when the verdict depends on
+    the eigenvectors this falls back to :func:`hill_stability`.
+    """
+    opts = options or StabilityOptions()
+    A = hill_matrix(J, M, C, basis, w)
+    if not np.all(np.isfinite(A)):
+        return hill_stability(J, M, C, basis, w, opts).stable      # raises as eig does
+    lam = sla.eigvals(A, overwrite_a=True, check_finite=False)
+    verdict = verdict_from_eigenvalues(lam, M.shape[0], w, opts.rel_tol)
+    if verdict is None:
+        return hill_stability(J, M, C, basis, w, opts).stable
+    return verdict
+
+
+def point_is_stable(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> bool:
+    """``point_stability(problem, X, w, options).stable`` by :func:`hill_is_stable`."""
+    _, J, _ = problem.residual(X, w)
+    fr = np.ix_(problem.free, problem.free)
+    return hill_is_stable(J, problem.model.M[fr], problem.model.C[fr], problem.basis, w, options)
 
 
 def point_stability(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> HillResult:
