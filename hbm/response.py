@@ -27,7 +27,7 @@ from .jumps import predict_jumps
 from .newton import newton
 from .reduction_cache import cache_path, reduce_cached
 from .residual import HarmonicBalance
-from .stability import StabilityOptions, point_stability
+from .stability import StabilityOptions, point_is_stable
 from .structure import AUTO_CONDENSE_DOF
 from .transforms import make_transform
 
@@ -429,7 +429,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     settings["segments"] = segments
     stable = None
     if stability:
-        stable = np.array([point_stability(problem, X, w, stability_options).stable
+        stable = np.array([point_is_stable(problem, X, w, stability_options)
                            for X, w in zip(pts_X, pts_w)], dtype=bool)
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
@@ -482,7 +482,7 @@ def _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
             fun = lambda x: problem.residual(problem.expand(x), w)[:2]
             res = newton(fun, problem.unknowns(X0), scale=xscale, r_scale=r_scale)
             X = problem.expand(res.x) if res.converged else None
-            if X is not None and not point_stability(problem, X, w, stability_options).stable:
+            if X is not None and not point_is_stable(problem, X, w, stability_options):
                 X = None
             cache[key] = X
         return cache[key]

@@ -58,6 +58,14 @@ of one root are spuriously unstable, a known defect of hysteretic damping in the
 
 The solution is asymptotically stable when :math:`\max \mathrm{Re}\,\lambda < \tau w`
 with a small relative tolerance :math:`\tau` (:class:`StabilityOptions`).
+
+**Verdict without eigenvectors** (:func:`hill_is_stable`, used along an FRF).  Only the
+choice among more than ``2n`` in-strip eigenvalues needs the eigenvectors; with ``m``
+eigenvalues in the strip of which ``b`` are unstable, the verdict is *stable* when ``b = 0``
+and *unstable* when ``b > m - 2n`` (some unstable one must be kept), whatever the choice;
+with ``m < 2n`` the fill-ins are chosen by ``|Im|`` alone.  Only ``0 < b <= m - 2n`` needs
+the vectors (the full :func:`hill_stability`).  The eigenvalues come from the same LAPACK
+``geev`` reduction and QR iteration with and without vectors, so the verdict is the same.
 """
 from __future__ import annotations
 
@@ -113,17 +121,12 @@ class HillResult:
     stable: bool
 
 
-def _harmonic_rows(basis: FourierBasis):
-    """``[(h, row_c, row_s or None), ...]`` for the harmonics of ``basis``."""
-    out, r = [], 0
-    for h in basis.harmonics:
-        if h == 0:
-            out.append((0, r, None))
-            r += 1
-        else:
-            out.append((int(h), r, r + 1))
-            r += 2
-    return out
+def _pair_rows(basis: FourierBasis):
+    """Cosine rows ``rc`` (k,) of the harmonics ``h > 0`` (sine row ``rc + 1``), their
+    harmonics ``h`` (k,), and the row of harmonic 0 (``None`` if absent)."""
+    hr = basis.h_of_row
+    rc = np.flatnonzero(hr > 0)[::2]
+    return rc, hr[rc], (0 if hr[0] == 0 else None)
 
 
 def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis, w: float) -> np.ndarray:
@@ -142,7 +145,8 @@ def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis
     Returns
     -------
     A : ndarray, shape (2 n_u, 2 n_u)
-        ``[[0, I], [-D2^{-1} J, -D2^{-1} D1]]``.
+        ``[[0, I], [-D2^{-1} J, -D2^{-1} D1]]``, filled block by block through a 6-D view
+        (no loop over harmonics).
     """
     n = M.shape[0]
     nc = basis.n_coef
@@ -151,22 +155,19 @@ def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis
         raise ValueError(f"J must be ({nu}, {nu}) for {nc} coefficients x {n} dofs, got {J.shape}")
     Minv = np.linalg.inv(M)
     MinvC = Minv @ C
-    eye = np.eye(n)
     A = np.zeros((2 * nu, 2 * nu))
-    A[:nu, nu:] = np.eye(nu)
+    A6 = A.reshape(2, nc, n, 2, nc, n)
+    r = np.arange(nc)
+    A6[0, r, :, 1, r, :] = np.eye(n)
     # -D2^{-1} J: M^{-1} applied to every coefficient row-block of J
-    A[nu:, :nu] = -np.einsum("ab,kbl->kal", Minv, J.reshape(nc, n, nu)).reshape(nu, nu)
-    # -D2^{-1} D1, block diagonal per harmonic
-    B = A[nu:, nu:]
-    for h, rc, rs in _harmonic_rows(basis):
-        c = slice(rc * n, (rc + 1) * n)
-        B[c, c] = -MinvC
-        if rs is None:
-            continue
-        s = slice(rs * n, (rs + 1) * n)
-        B[s, s] = -MinvC
-        B[c, s] = -2.0 * h * w * eye
-        B[s, c] = 2.0 * h * w * eye
+    A6[1, :, :, 0, :, :] = -np.einsum("ab,kbl->kal", Minv, J.reshape(nc, n, nu)).reshape(nc, n, nc, n)
+    # -D2^{-1} D1, block diagonal per harmonic: -M^{-1} C on the diagonal, -+2 h w I coupling
+    A6[1, r, :, 1, r, :] = -MinvC
+    rc, h, _ = _pair_rows(basis)
+    if rc.size:
+        g = (2.0 * w * h)[:, None, None] * np.eye(n)[None]
+        A6[1, rc, :, 1, rc + 1, :] = -g
+        A6[1, rc + 1, :, 1, rc, :] = g
     return A
 
 
@@ -190,20 +191,18 @@ def complex_index_weights(P: np.ndarray, basis: FourierBasis, n: int):
     """
     m = P.shape[1]
     Pr = P.reshape(basis.n_coef, n, m)
-    idx, rows = [], []
-    for h, rc, rs in _harmonic_rows(basis):
-        if rs is None:
-            idx.append(0)
-            rows.append(np.sum(np.abs(Pr[rc]) ** 2, axis=0))
-        else:
-            cp = 0.5 * (Pr[rc] - 1j * Pr[rs])
-            cm = 0.5 * (Pr[rc] + 1j * Pr[rs])
-            idx += [h, -h]
-            rows += [np.sum(np.abs(cp) ** 2, axis=0), np.sum(np.abs(cm) ** 2, axis=0)]
-    W = np.array(rows)
+    rc, h, r0 = _pair_rows(basis)
+    cp = 0.5 * (Pr[rc] - 1j * Pr[rc + 1])              # (k, n, m): c_{+h}
+    cm = 0.5 * (Pr[rc] + 1j * Pr[rc + 1])              # c_{-h}
+    pairs = np.stack([np.sum(np.abs(cp) ** 2, axis=1), np.sum(np.abs(cm) ** 2, axis=1)], axis=1)
+    W = pairs.reshape(2 * rc.size, m)
+    idx = np.stack([h, -h], axis=1).reshape(-1)
+    if r0 is not None:
+        W = np.concatenate([np.sum(np.abs(Pr[r0]) ** 2, axis=0)[None], W])
+        idx = np.r_[0, idx]
     tot = W.sum(axis=0)
     W = W / np.where(tot > 0, tot, 1.0)
-    return np.array(idx, dtype=np.int64), W
+    return idx.astype(np.int64), W
 
 
 def fold_exponents(lam: np.ndarray, w: float) -> np.ndarray:
@@ -270,6 +269,86 @@ def hill_stability(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBa
     ex = ex[np.argsort(-ex.real, kind="stable")]
     max_real = float(ex.real.max())
     return HillResult(ex, lam, mean_index, max_real, bool(max_real < opts.rel_tol * w))
+
+
+def verdict_from_eigenvalues(hill_eigenvalues: np.ndarray, n: int, w: float, rel_tol: float):
+    """The verdict of :func:`hill_stability` decided from the Hill eigenvalues alone.
+
+    The filter (:func:`select_exponents`) needs eigenvectors only to choose among more than
+    ``2 n`` in-strip eigenvalues; the verdict does not depend on that choice when no in-strip
+    eigenvalue is unstable (``Re >= rel_tol * w``), or when there are more unstable ones
+    than can be left out.  With fewer than ``2 n`` in the strip every in-strip eigenvalue is
+    kept and the fill-ins are chosen by ``|Im|`` alone.
+
+    Parameters
+    ----------
+    hill_eigenvalues : ndarray of complex, shape (m,)
+        All eigenvalues of the truncated Hill problem, in the order LAPACK returns them
+        (it breaks ties of the fill-in order, as in :func:`select_exponents`).
+    n : int
+        Number of DOFs.
+    w : float
+        Angular frequency, rad/s.
+    rel_tol : float
+        :attr:`StabilityOptions.rel_tol`.
+
+    Returns
+    -------
+    bool or None
+        ``HillResult.stable`` of the same eigenvalues, or ``None`` when it depends on the
+        eigenvectors (or on how a tie in the fill-in order is broken).
+    """
+    lam = hill_eigenvalues
+    k = min(2 * n, lam.size)
+    im = lam.imag
+    inside = (im > -0.5 * w) & (im <= 0.5 * w)
+    bad = ~(lam.real < rel_tol * w)                  # fails max_real < rel_tol * w
+    m_in = int(inside.sum())
+    bad_in = int((bad & inside).sum())
+    if m_in >= k:
+        # the kept ones are k of the m_in in-strip eigenvalues
+        if bad_in == 0:
+            return True
+        return False if bad_in > m_in - k else None
+    if bad_in:
+        return False
+    # every in-strip one is kept, plus the first k - m_in outside in select_exponents' order
+    out = np.flatnonzero(~inside)
+    key = np.round(np.abs(im[out]) / w, 9)
+    order = np.lexsort((out, key))
+    n_fill = k - m_in
+    last = key[order[n_fill - 1]]
+    tie = key == last
+    if np.any(bad[out[tie]]) and not np.all(bad[out[tie]]):
+        return None                                  # the choice inside a tie decides
+    return not np.any(bad[out[order[:n_fill]]])
+
+
+def hill_is_stable(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis, w: float,
+                   options: StabilityOptions | None = None) -> bool:
+    """``hill_stability(J, M, C, basis, w, options).stable``, computed without eigenvectors
+    whenever :func:`verdict_from_eigenvalues` can decide it (parameters as there).
+
+    LAPACK's ``geev`` runs the same reduction and QR iteration with and without vectors, so
+    the eigenvalues are those :func:`hill_stability` filters; when the verdict depends on
+    the eigenvectors this falls back to :func:`hill_stability`.
+    """
+    opts = options or StabilityOptions()
+    A = hill_matrix(J, M, C, basis, w)
+    if not np.all(np.isfinite(A)):
+        return hill_stability(J, M, C, basis, w, opts).stable      # raises as eig does
+    lam = sla.eigvals(A, overwrite_a=True, check_finite=False)
+    verdict = verdict_from_eigenvalues(lam, M.shape[0], w, opts.rel_tol)
+    if verdict is None:
+        return hill_stability(J, M, C, basis, w, opts).stable
+    return verdict
+
+
+def point_is_stable(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> bool:
+    """``point_stability(problem, X, w, options).stable`` by :func:`hill_is_stable`."""
+    _, J, _ = problem.residual(X, w)
+    fr = np.ix_(problem.free, problem.free)
+    return hill_is_stable(J, problem.model.M[fr], problem.model.C[fr], problem.basis, w, options)
 
 
 def point_stability(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> HillResult:
