@@ -16,8 +16,12 @@ Sections (every figure is measured in this run; speeds are reported as ratios):
 2. The three AFT transforms (DFT matrix, NumPy FFT, pyFFTW) across H: time of one
    synthesis + analysis of an element's seeded signals, and which wins.
 3. The numba march against a plain NumPy/Python implementation of the same Jenkins law.
-4. The issue's target case (3-DOF, two Jenkins, H = 7, N = 256) and where one Newton
-   iteration's time goes (residual + Jacobian, its transforms, its linear solve).
+4. The issue's target case (3-DOF, two Jenkins, H = 7, N = 256): the FRF with default
+   steps and with about 300 points, one Newton iteration against its transforms plus its
+   linear solve, and where the FRF's time goes (cProfile, grouped).
+5. The reduction issue's target: the UPD-like rig of ``benchmarks/upd_like.toml``.
+
+``--targets`` runs sections 4 and 5 only (a minute).
 
 Writes ``benchmarks/results/time_vs_error.csv`` and ``time_vs_error.png``.
 CPU time (``time.process_time``), best of repeats, so a busy machine perturbs it less.
@@ -268,9 +272,8 @@ def section_numba(quick):
 
 
 # ----------------------------------------------------------------------------- section 4
-def section_target():
-    print("\n== 4. Target case: 3-DOF, two Jenkins, H = 7, N = 256")
-    c = case_from_dict({
+def target_case():
+    return case_from_dict({
         "name": "3-DOF two Jenkins",
         "model": {"mass": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
                   "stiffness": [[2e4, -1e4, 0], [-1e4, 2e4, -1e4], [0, -1e4, 2e4]], "modal_damping": 0.005},
@@ -280,12 +283,51 @@ def section_target():
         "analysis": {"harmonics": 7, "time_samples": 256, "frequency_hz": [5.0, 40.0],
                      "outputs": {"a": 0, "c": 2}},
     })
+
+
+# where a profiled FRF spends its time: (label, predicate on (file, function name))
+PROFILE_GROUPS = (
+    ("element march + AFT (numba)", lambda f, n: "aft_kernel" in f or "law_march" in f or "closure" in f),
+    ("dense linear solves (LAPACK)", lambda f, n: "linalg" in f and n in ("solve", "inv", "eig", "eigvals")),
+    ("linear part Z(w) X", lambda f, n: n in ("linear_part", "_linear", "_receptances")),
+    ("Hill stability", lambda f, n: "stability" in f),
+)
+
+
+def profile_groups(fun):
+    """Self time of ``fun()`` per group of :data:`PROFILE_GROUPS` (the rest: Python glue)."""
+    import cProfile
+    import pstats
+    pr = cProfile.Profile()
+    pr.enable()
+    fun()
+    pr.disable()
+    st = pstats.Stats(pr).stats
+    total = sum(v[2] for v in st.values())
+    out = {label: 0.0 for label, _ in PROFILE_GROUPS}
+    for (f, _, n), v in st.items():
+        for label, pred in PROFILE_GROUPS:
+            if pred(f, n):
+                out[label] += v[2]
+                break
+    out["Python glue (continuation, driver, numpy calls)"] = total - sum(out.values())
+    return {k: v / total for k, v in out.items()}
+
+
+def section_target():
+    print("\n== 4. Target case: 3-DOF, two Jenkins, H = 7, N = 256")
+    c = target_case()
     hbm.frf(c, stability=False)
-    t, res = cpu(lambda: hbm.frf(c, stability=False), repeat=3)
-    t_st, res_st = cpu(lambda: hbm.frf(c), repeat=1)
-    print(f"  FRF: {res.freq_hz.size} points, {res.iterations.sum()} Newton iterations, "
+    t, res = cpu(lambda: hbm.frf(c, stability=False), repeat=5)
+    t_st, _ = cpu(lambda: hbm.frf(c), repeat=2)
+    print(f"  FRF (default steps): {res.freq_hz.size} points, {res.iterations.sum()} Newton iterations, "
           f"{res.n_rejected} rejected steps, {t:.3f} s CPU ({t / res.freq_hz.size * 1e3:.2f} ms/point); "
           f"with Hill stability of every point {t_st:.3f} s")
+    # about 300 points: the largest step limited to 1/60 (scaled units: the frequency range is 1)
+    opts = ArclengthOptions(ds_max=1.0 / 60, ds0=1.0 / 60)
+    t300, r300 = cpu(lambda: hbm.frf(c, stability=False, options=opts), repeat=5)
+    print(f"  FRF (ds_max = 1/60): {r300.freq_hz.size} points, {r300.iterations.sum()} Newton "
+          f"iterations, {t300:.3f} s CPU ({t300 / r300.freq_hz.size * 1e3:.2f} ms/point)")
     b = FourierBasis(np.arange(1, 8), 256)
     pb, _ = build_problem(c, b, "auto")
     X = res.X[res.X.shape[0] // 2]
@@ -310,8 +352,33 @@ def section_target():
     print(f"  one Newton iteration (residual + exact Jacobian): {t_call * 1e6:.0f} us; its transforms "
           f"{t_tr * 1e6:.0f} us, its bordered linear solve {t_lin * 1e6:.0f} us: "
           f"ratio {t_call / (t_tr + t_lin):.1f}x (transforms + solve)")
-    return dict(points=res.freq_hz.size, seconds=t, iteration_us=t_call * 1e6,
-                transforms_us=t_tr * 1e6, solve_us=t_lin * 1e6)
+    print("  where the FRF's time goes (cProfile self time, without stability):")
+    for k, v in profile_groups(lambda: hbm.frf(c, stability=False)).items():
+        print(f"    {k:<50} {100 * v:5.1f} %")
+    return dict(points=res.freq_hz.size, seconds=t, points_300=r300.freq_hz.size, seconds_300=t300,
+                iteration_us=t_call * 1e6, transforms_us=t_tr * 1e6, solve_us=t_lin * 1e6)
+
+
+def section_upd_like():
+    """The reduction issue's target: the UPD-like rig (benchmarks/upd_like.toml, condensed)."""
+    import tomllib
+    print("\n== 5. UPD-like rig: two beam blades, damper with two friction3d contacts, H = 3")
+    data = tomllib.loads((ROOT / "benchmarks" / "upd_like.toml").read_text())
+    c = case_from_dict(data, str(ROOT / "benchmarks" / "upd_like.toml"), ROOT / "benchmarks")
+    hbm.frf(c, stability=False)
+    t, res = cpu(lambda: hbm.frf(c, stability=False), repeat=3)
+    t_st, _ = cpu(lambda: hbm.frf(c), repeat=1)
+    print(f"  {c.n_dof} DOFs, solver {res.settings['solver']}: {res.freq_hz.size} points, "
+          f"{res.iterations.sum()} Newton iterations, {t:.3f} s CPU ({t / res.freq_hz.size * 1e3:.2f} "
+          f"ms/point); with Hill stability {t_st:.3f} s")
+    opts = ArclengthOptions(ds_max=1.0 / 60, ds0=1.0 / 60)
+    t300, r300 = cpu(lambda: hbm.frf(c, stability=False, options=opts), repeat=3)
+    print(f"  FRF (ds_max = 1/60): {r300.freq_hz.size} points, {r300.iterations.sum()} Newton iterations, "
+          f"{t300:.3f} s CPU")
+    print("  where the FRF's time goes (cProfile self time, without stability):")
+    for k, v in profile_groups(lambda: hbm.frf(c, stability=False)).items():
+        print(f"    {k:<50} {100 * v:5.1f} %")
+    return dict(points=res.freq_hz.size, seconds=t, points_300=r300.freq_hz.size, seconds_300=t300)
 
 
 def write_results(rows, path_csv, path_png):
@@ -343,11 +410,17 @@ def write_results(rows, path_csv, path_png):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer settings")
+    ap.add_argument("--targets", action="store_true", help="sections 4 and 5 only (the speed targets)")
     args = ap.parse_args(argv)
+    if args.targets:
+        section_target()
+        section_upd_like()
+        return
     rows = section_accuracy(args.quick)
     section_transforms(args.quick)
     section_numba(args.quick)
     section_target()
+    section_upd_like()
     write_results(rows, RESULTS / "time_vs_error.csv", RESULTS / "time_vs_error.png")
     print(f"\nwrote {RESULTS / 'time_vs_error.csv'} and {RESULTS / 'time_vs_error.png'}")
 

@@ -38,8 +38,8 @@ class EnergyBalance:
 
 def work(basis, F: np.ndarray, V: np.ndarray, w: float) -> float:
     """Work per period of forces ``F`` (n_coef, n) on velocities ``V`` (n_coef, n)."""
-    mask = basis.h_of_row > 0
-    return float(np.pi / w * np.sum(F[mask] * V[mask]))
+    s = 1 if basis.has_zero else 0          # harmonic 0 is the first row when present
+    return float(np.pi / w * np.vdot(F[s:], V[s:]))
 
 
 def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
