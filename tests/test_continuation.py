@@ -260,3 +260,25 @@ def test_options_are_frozen_and_validated():
         ArclengthOptions(max_angle_deg=120)
     ds0, ds_min, ds_max = o.step_lengths(3.0)
     assert ds0 == pytest.approx(0.03) and ds_min < ds0 < ds_max
+
+
+def test_corrector_null_vector_is_the_tangent_system_solution():
+    """The converged corrector's second solve gives null_tangent's vector (same matrix)."""
+    from continuation.corrector import Evaluation, correct, linear_constraint
+    from continuation.tangent import null_tangent
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((4, 5))
+
+    def evaluate(xs):
+        x = xs.copy()
+        R = A @ x + 0.1 * x[:4] ** 3 - 1.0
+        J = A.copy()
+        J[:, :4] += np.diag(0.3 * x[:4] ** 2)
+        return Evaluation(xs.copy(), R, J)
+    t = np.ones(5) / np.sqrt(5)
+    c = correct(evaluate, np.zeros(5), linear_constraint(t, 0.2), None, 1e-12, 20, 4)
+    assert c.converged and c.null is not None
+    v = c.null / np.linalg.norm(c.null)
+    ref = null_tangent(c.ev.Js, t)
+    assert np.abs(v - ref).max() < 1e-12
+    assert abs(t @ c.null - 1.0) < 1e-12      # normalised by the constraint row
