@@ -44,9 +44,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .aft import NonlinearForces
-from .energy import EnergyBalance, work
+from .energy import EnergyBalance
 from .fourier import FourierBasis
-from .reduction import ReducedModel, condense, modal_outer, receptance_stack
+from .condensed_kernels import condensed_linear, modal_receptances, proportional_linear
+from .reduction import ReducedModel, condense, receptance_stack
 
 _RANK_TOL = 1e-10
 
@@ -114,8 +115,8 @@ class _LinearPart:
     H, dH : ndarray, complex, shape (n_h, n_p, n_p)
         Receptances and their ``W``-derivatives between all kept coordinates (contact,
         excitation, output, in that order) at ``W = h w`` for every harmonic.
-    Z, dZ : ndarray, complex, shape (n_h, n_c, n_c)
-        ``Z_c(h w) = H_cc^{-1}`` and ``dZ_c/dW``.
+    Z : ndarray, complex, shape (n_h, n_c, n_c)
+        ``Z_c(h w) = H_cc^{-1}``.
     J, dJ : ndarray, shape (n_u, n_u)
         ``dR/dU`` of the linear part (``Z_c`` in real block form on the unknown vector) and its
         ``w``-derivative (``h dZ_c/dW`` per harmonic).
@@ -126,7 +127,6 @@ class _LinearPart:
     H: np.ndarray
     dH: np.ndarray
     Z: np.ndarray
-    dZ: np.ndarray
     J: np.ndarray
     dJ: np.ndarray
     F: np.ndarray
@@ -137,10 +137,12 @@ class CondensedHarmonicBalance:
     """Residual ``R(U, w)`` on the contact coordinates (module docstring); the interface of
     :class:`hbm.residual.HarmonicBalance` used by :mod:`hbm.response` and :mod:`hbm.energy`.
 
-    Every harmonic is handled at once: the receptances of all kept coordinates come from one
-    product over the modes, ``Z_c`` from one batched inverse, and the real Jacobian blocks are
-    written through a 4-D view of the Jacobian.  The linear part is memoised for the last ``w``
-    and the nonlinear forces for the last residual evaluation (exact ``X`` and ``w`` only).
+    Every harmonic is handled at once, in one compiled call (:mod:`hbm.condensed_kernels`):
+    the receptances of all kept coordinates from one product over the modes, ``Z_c`` per
+    harmonic, and the real Jacobian ``dR/dU`` of the linear part with its ``w``-derivative, so
+    that a residual is two matrix-vector products plus the AFT.  The linear part is memoised
+    for the last ``w`` and the nonlinear forces for the last residual evaluation (exact ``X``
+    and ``w`` only: re-used, they are the same numbers).
 
     Parameters
     ----------
@@ -200,7 +202,12 @@ class CondensedHarmonicBalance:
         self._sl = {"c": slice(0, nc), "e": slice(nc, nc + ne), "o": slice(nc + ne, nc + ne + no)}
         self._phi_all = G_all @ reduced.phi
         self._R_all = G_all @ reduced.residual @ G_all.T
-        self._outer = modal_outer(self._phi_all) if reduced.proportional else None
+        self._om2 = np.ascontiguousarray(reduced.omega ** 2)
+        self._cdiag = np.ascontiguousarray(np.diag(reduced.modal_c))
+        ia, ib = np.triu_indices(self._phi_all.shape[0])
+        self._tri = (ia.astype(np.int64), ib.astype(np.int64))
+        self._Pu = np.ascontiguousarray(self._phi_all[ia].T * self._phi_all[ib].T)   # (m, n_t)
+        self._Ru = np.ascontiguousarray(self._R_all[ia, ib])
         self._phi = {k: self._phi_all[s] for k, s in self._sl.items()}
         # harmonic rows: cosine (or mean) row of every harmonic, sine rows of h > 0
         h = np.asarray(basis.harmonics)
@@ -210,6 +217,14 @@ class CondensedHarmonicBalance:
         self._pos = np.flatnonzero(h > 0)
         self._zero = np.flatnonzero(h == 0)
         self._rs = self._rc[self._pos] + 1
+        # complex amplitudes Xc - i Xs per harmonic from real coefficients and back, as products
+        to_c = np.zeros((h.size, nco), dtype=complex)
+        to_c[np.arange(h.size), self._rc] = 1.0
+        to_c[self._pos, self._rs] = -1j
+        to_r = np.zeros((nco, h.size), dtype=complex)
+        to_r[self._rc, np.arange(h.size)] = 1.0
+        to_r[self._rs, self._pos] = 1j
+        self._to_c, self._to_r = to_c, to_r
         self._Fe_c = self._complex(F_e)
         d = self.nl.dofs
         self._nl_all = d.size == nc
@@ -243,71 +258,44 @@ class CondensedHarmonicBalance:
     # ------------------------------------------------------------------ complex form
     def _complex(self, X: np.ndarray) -> np.ndarray:
         """Real coefficients (n_coef, q) -> complex amplitudes ``Xc - i Xs`` per harmonic (n_h, q)."""
-        out = np.zeros((self._h.size, X.shape[1]), dtype=complex)
-        out.real = X[self._rc]
-        out.imag[self._pos] = -X[self._rs]
-        return out
+        return self._to_c @ X
 
     def _real(self, Y: np.ndarray) -> np.ndarray:
-        """Complex amplitudes per harmonic (n_h, q) -> real coefficients (n_coef, q)."""
-        out = np.empty((self.basis.n_coef, Y.shape[1]))
-        out[self._rc] = Y.real
-        out[self._rs] = -Y.imag[self._pos]
-        return out
-
-    def _real_blocks(self, Z: np.ndarray, static: bool) -> np.ndarray:
-        """Block-diagonal real matrix (n_u, n_u) of complex blocks ``Z`` (n_h, n_c, n_c):
-        ``[[Re Z, Im Z], [-Im Z, Re Z]]`` on ``[Xc_h, Xs_h]`` and ``Re Z`` on ``X_0`` (if ``static``)."""
-        nco, n = self.basis.n_coef, self.n_dof
-        J = np.zeros((nco * n, nco * n))
-        Jv = J.reshape(nco, n, nco, n)
-        c, s = self._rc[self._pos], self._rs
-        Zp = Z[self._pos]
-        zr, zi = Zp.real, Zp.imag
-        Jv[c, :, c, :] = zr
-        Jv[c, :, s, :] = zi
-        Jv[s, :, c, :] = -zi
-        Jv[s, :, s, :] = zr
-        if static and self._zero.size:
-            k0 = self._rc[self._zero]
-            Jv[k0, :, k0, :] = Z[self._zero].real
-        return J
+        """Complex amplitudes per harmonic (n_h, q) -> real coefficients (n_coef, q):
+        ``Xc = Re Y``, ``Xs = Re(i Y) = -Im Y``."""
+        return (self._to_r @ Y).real
 
     # ------------------------------------------------------------------ linear part
     def _receptances(self, Ws: np.ndarray):
         """``H(W)`` and ``dH/dW`` between all kept coordinates, (n_W, n_p, n_p) complex."""
         r = self.reduced
-        return receptance_stack(self._phi_all, r.omega, r.modal_c, r.proportional, self._R_all,
-                                Ws, self._outer)
+        Ws = np.ascontiguousarray(Ws, dtype=float)
+        if r.proportional:
+            return modal_receptances(self._Pu, *self._tri, self._phi_all.shape[0], self._om2,
+                                     self._cdiag, self._Ru, Ws)
+        H, dH = receptance_stack(self._phi_all, r.omega, r.modal_c, False, self._R_all, Ws)
+        return np.ascontiguousarray(H), np.ascontiguousarray(dH)
 
     def _linear(self, w: float) -> _LinearPart:
-        """The linear part at ``w`` (:class:`_LinearPart`).
+        """The linear part at ``w`` (:class:`_LinearPart`), from one compiled call
+        (:mod:`hbm.condensed_kernels`).
 
         Memoised for the last ``w`` only (Newton at a fixed frequency re-uses it).
         """
         w = float(w)
         if self._memo_w == w:
             return self._memo
-        H, dH = self._receptances(self._h * w)
-        c, e = self._sl["c"], self._sl["e"]
-        try:
-            Z = np.linalg.inv(H[:, c, c])
-        except np.linalg.LinAlgError:
-            raise ValueError("contact receptance is singular (dependent contact coordinates?)") from None
-        dZ = -Z @ dH[:, c, c] @ Z
-        i1 = self._i1
-        hce, dhce = H[i1, c, e][:, 0], dH[i1, c, e][:, 0]
-        t = Z[i1] @ hce                                 # unit cosine force at harmonic 1
-        dt = dZ[i1] @ hce + Z[i1] @ dhce
-        n = self.n_dof
-        F = np.zeros((self.basis.n_coef, n))
-        dF = np.zeros_like(F)
-        k = self._rc[i1]
-        F[k], F[k + 1] = t.real, -t.imag                # Fc - i Fs = t
-        dF[k], dF[k + 1] = dt.real, -dt.imag
-        J = self._real_blocks(Z, static=True)
-        dJ = self._real_blocks(self._h[:, None, None] * dZ, static=False)
-        self._memo = _LinearPart(H, dH, Z, dZ, J, dJ, F.reshape(-1), dF.reshape(-1))
+        rows, nc, ie, i1 = self._rc, self.n_dof, self._sl["e"].start, self._i1
+        if self.reduced.proportional:
+            ok, H, dH, Z, JJ, FF = proportional_linear(
+                self._Pu, *self._tri, self._phi_all.shape[0], self._om2, self._cdiag, self._Ru,
+                self._h, w, rows, nc, ie, i1)
+        else:
+            H, dH = self._receptances(self._h * w)
+            ok, Z, JJ, FF = condensed_linear(H, dH, self._h, rows, nc, ie, i1)
+        if not ok:
+            raise ValueError("contact receptance is singular (dependent contact coordinates?)")
+        self._memo = _LinearPart(H, dH, Z, JJ[0], JJ[1], FF[0], FF[1])
         self._memo_w = w
         return self._memo
 
@@ -441,27 +429,31 @@ class CondensedHarmonicBalance:
         return self._respond("o", self._implied_forces(X, L), L)
 
     def energy_balance(self, X: np.ndarray, w: float) -> EnergyBalance:
-        """Work per period of the excitation, the viscous and the nonlinear forces (module doc)."""
-        basis = self.basis
+        """Work per period of the excitation, the viscous and the nonlinear forces (module doc).
+
+        In complex form per harmonic (``X_h = Xc - i Xs``, velocity ``i h w X_h``), the work of
+        ``F`` on the motion ``Y`` over a period is ``-pi sum_h h Im(conj(F_h) Y_h)``.
+        """
         r = self.reduced
         L = self._linear(w)
         fp = self._implied_forces(X, L)
-        V = w * (basis.D @ X)
-        w_nl = work(basis, self.nonlinear_forces(X, w), V, w)
-        w_ex = work(basis, self.F_e, w * (basis.D @ self._respond("e", fp, L)), w)
-        # modal amplitudes of the structure under F_e and -F' (harmonics h > 0)
-        p = self._pos
-        W = self._h[p] * w
-        g = self._Fe_c[p] @ self._phi["e"] - fp[p] @ self._phi["c"]        # (n_h+, m)
+        w_nl = np.pi * float(np.vdot(self.nonlinear_forces(X, w), self.basis.D @ X))
+        # excitation coordinate y_e = H_ee F_e - H_ec F'
+        se, sc = self._sl["e"], self._sl["c"]
+        fe = self._Fe_c
+        ye = (L.H[:, se, se] @ fe[:, :, None] - L.H[:, se, sc] @ fp[:, :, None])[:, :, 0]
+        w_ex = -np.pi * float(np.sum(self._h[:, None] * (fe.conj() * ye).imag))
+        # modal amplitudes of the structure under F_e and -F' (the mean does no work: W = 0)
+        W = self._h * w
+        g = fe @ self._phi["e"] - fp @ self._phi["c"]                       # (n_h, m)
         Cm = r.modal_c
-        om2 = r.omega ** 2
         if r.proportional:
-            eta = g / (om2[None, :] - (W * W)[:, None] + 1j * W[:, None] * np.diag(Cm)[None, :])
+            eta = g / (self._om2[None, :] - (W * W)[:, None] + 1j * W[:, None] * self._cdiag[None, :])
         else:
             D = 1j * W[:, None, None] * Cm[None, :, :]
-            ar = np.arange(om2.size)
-            D[:, ar, ar] += om2[None, :] - (W * W)[:, None]
+            ar = np.arange(self._om2.size)
+            D[:, ar, ar] += self._om2[None, :] - (W * W)[:, None]
             eta = np.linalg.solve(D, g[:, :, None])[:, :, 0]
         v = 1j * W[:, None] * eta
-        w_v = float(np.real(np.sum(v.conj() * (v @ Cm.T))))
+        w_v = float(np.real(np.vdot(v, v @ Cm.T)))
         return EnergyBalance(w_ex, np.pi / w * w_v, w_nl)

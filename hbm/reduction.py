@@ -230,19 +230,7 @@ def _receptance(phi_a, phi_b, omega, modal_c, proportional, R_ab, W):
     return H, dH
 
 
-def modal_outer(phi: np.ndarray) -> np.ndarray:
-    """Outer products ``phi_r phi_r^T`` of the modes, flattened: (m, p * p) complex.
-
-    Parameters
-    ----------
-    phi : ndarray, shape (p, m)
-        Mode shapes at ``p`` coordinates.
-    """
-    m = phi.shape[1]
-    return np.einsum("ir,jr->rij", phi, phi).reshape(m, -1).astype(complex)
-
-
-def receptance_stack(phi, omega, modal_c, proportional, R, Ws, outer=None):
+def receptance_stack(phi, omega, modal_c, proportional, R, Ws):
     """``H(W) = phi D(W)^{-1} phi^T + R`` and ``dH/dW`` for many ``W`` at once (complex).
 
     Parameters
@@ -257,8 +245,6 @@ def receptance_stack(phi, omega, modal_c, proportional, R, Ws, outer=None):
         Residual flexibility at the coordinates.
     Ws : ndarray, shape (n_W,)
         Angular frequencies, rad/s.
-    outer : ndarray, shape (m, p * p), optional
-        :func:`modal_outer` of ``phi`` (proportional case), if already formed.
 
     Returns
     -------
@@ -269,8 +255,7 @@ def receptance_stack(phi, omega, modal_c, proportional, R, Ws, outer=None):
     om2 = omega * omega
     k = Ws.size
     if proportional:
-        if outer is None:
-            outer = modal_outer(phi)
+        outer = np.einsum("ir,jr->rij", phi, phi).reshape(m, p * p)
         c = np.diag(modal_c)
         inv = 1.0 / (om2[None, :] - Ws[:, None] ** 2 + 1j * Ws[:, None] * c[None, :])
         dinv = (2.0 * Ws[:, None] - 1j * c[None, :]) * inv * inv
