@@ -39,7 +39,7 @@ the same check as the full model's (there ``-W[R, \dot X]``).
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -106,8 +106,7 @@ def _regathered(element, A):
     return e
 
 
-@dataclass(frozen=True)
-class _LinearPart:
+class _LinearPart(NamedTuple):
     """The linear part at one fundamental frequency ``w`` (see :meth:`CondensedHarmonicBalance._linear`).
 
     Attributes
@@ -318,31 +317,43 @@ class CondensedHarmonicBalance:
         dRdX : ndarray, shape (n_u, n_u)
         dRdw : ndarray, shape (n_u,)
         """
+        nu = self.n_unknowns
+        J = np.empty((nu, nu))
+        R, dRw = self._evaluate(X, w, J)
+        return R, J, dRw
+
+    def __call__(self, x: np.ndarray):
+        """Continuation form: ``x = [U.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dU, dR/dw]`` (n_u, n_u + 1)."""
+        nu = self.n_unknowns
+        A = np.empty((nu, nu + 1))
+        R, dRw = self._evaluate(x[:-1].reshape(self.basis.n_coef, self.n_dof), float(x[-1]), A[:, :nu])
+        A[:, nu] = dRw
+        return R, A
+
+    def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray):
+        """``R`` (n_u,) and ``dR/dw`` (n_u,) returned, ``dR/dU`` written into ``J`` (n_u, n_u)."""
         L = self._linear(w)
         x = X.reshape(-1)
         R = L.J @ x - L.F
         dRw = L.dJ @ x - L.dF
         if not self.nl.n_nl:
-            return R, L.J.copy(), dRw
+            J[...] = L.J
+            return R, dRw
         d = self.nl.dofs
-        Fn, dFn, dFw = self.nl.evaluate(np.ascontiguousarray(X[:, d]), w)
+        Xn = np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float)
+        Fn, dFn, dFw = self.nl.evaluate(Xn, w)
         self._last_nl = (float(w), np.array(X, dtype=float), Fn)
         if self._nl_all:
             R += Fn.reshape(-1)
             dRw += dFw.reshape(-1)
-            return R, L.J + dFn, dRw
+            np.add(L.J, dFn, out=J)
+            return R, dRw
         Rv, dRv = R.reshape(X.shape), dRw.reshape(X.shape)
         Rv[:, d] += Fn
         dRv[:, d] += dFw
-        J = L.J.copy()
+        J[...] = L.J
         J[self._nl_ix] += dFn
-        return R, J, dRw
-
-    def __call__(self, x: np.ndarray):
-        """Continuation form: ``x = [U.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dU, dR/dw]`` (n_u, n_u + 1)."""
-        X = x[:-1].reshape(self.basis.n_coef, self.n_dof)
-        R, J, dw = self.residual(X, float(x[-1]))
-        return R, np.hstack([J, dw[:, None]])
+        return R, dRw
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
         """``F_nl`` on the contact coordinates, (n_coef, n_c).

@@ -163,3 +163,25 @@ def test_compiled_inverse():
         assert np.abs(out - np.linalg.inv(A)).max() <= 1e-12 * np.abs(np.linalg.inv(A)).max()
     A = np.ones((3, 3), dtype=complex)
     assert not _invert(A, np.empty_like(A))
+
+
+@pytest.mark.parametrize("damping", ["modal", "matrix"])
+def test_receptance_stack_matches_single_frequency(damping):
+    from hbm.condensed_kernels import modal_receptances
+    from hbm.reduction import receptance_stack
+    p = problem(damping, 5)
+    r = p.reduced
+    phi = r.phi[:4]
+    Rk = r.residual[:4, :4]
+    Ws = 2 * np.pi * np.array([0.0, 0.8, 1.7, 2.9])
+    H, dH = receptance_stack(phi, r.omega, r.modal_c, r.proportional, Rk, Ws)
+    for W, h, dh in zip(Ws, H, dH):
+        ref, dref = r.receptance(W, derivative=True)
+        assert np.abs(h - ref[:4, :4]).max() <= 1e-12 * np.abs(ref).max()
+        assert np.abs(dh - dref[:4, :4]).max() <= 1e-12 * np.abs(dref).max()
+    if r.proportional:
+        ia, ib = np.triu_indices(4)
+        Hk, dHk = modal_receptances(np.ascontiguousarray(phi[ia].T * phi[ib].T), ia, ib, 4, r.omega ** 2,
+                                    np.diag(r.modal_c).copy(), Rk[ia, ib].copy(), Ws)
+        assert np.abs(Hk - H).max() <= 1e-12 * np.abs(H).max()
+        assert np.abs(dHk - dH).max() <= 1e-12 * np.abs(dH).max()
