@@ -46,7 +46,7 @@ import numpy as np
 from .aft import NonlinearForces
 from .energy import EnergyBalance
 from .fourier import FourierBasis
-from .condensed_kernels import condensed_linear, modal_receptances, proportional_linear
+from .condensed_kernels import assemble, condensed_linear, modal_receptances, proportional_linear
 from .reduction import ReducedModel, condense, receptance_stack
 
 _RANK_TOL = 1e-10
@@ -225,6 +225,7 @@ class CondensedHarmonicBalance:
         to_r[self._rs, self._pos] = 1j
         self._to_c, self._to_r = to_c, to_r
         self._Fe_c = self._complex(F_e)
+        self._ge = self._Fe_c @ self._phi["e"]          # Phi^T G_e^T F_e per harmonic, (n_h, m)
         d = self.nl.dofs
         self._nl_all = d.size == nc
         idx = (np.arange(nco)[:, None] * nc + d[None, :]).ravel()
@@ -318,42 +319,40 @@ class CondensedHarmonicBalance:
         dRdw : ndarray, shape (n_u,)
         """
         nu = self.n_unknowns
-        J = np.empty((nu, nu))
-        R, dRw = self._evaluate(X, w, J)
+        J, dRw = np.empty((nu, nu)), np.empty(nu)
+        R = self._evaluate(X, w, J, dRw)
         return R, J, dRw
 
     def __call__(self, x: np.ndarray):
         """Continuation form: ``x = [U.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dU, dR/dw]`` (n_u, n_u + 1)."""
         nu = self.n_unknowns
         A = np.empty((nu, nu + 1))
-        R, dRw = self._evaluate(x[:-1].reshape(self.basis.n_coef, self.n_dof), float(x[-1]), A[:, :nu])
-        A[:, nu] = dRw
+        R = self._evaluate(x[:-1].reshape(self.basis.n_coef, self.n_dof), float(x[-1]), A[:, :nu], A[:, nu])
         return R, A
 
-    def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray):
-        """``R`` (n_u,) and ``dR/dw`` (n_u,) returned, ``dR/dU`` written into ``J`` (n_u, n_u)."""
+    def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray, dRw: np.ndarray) -> np.ndarray:
+        """``R`` (n_u,) returned; ``dR/dU`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw`` (n_u,)."""
         L = self._linear(w)
         x = X.reshape(-1)
-        R = L.J @ x - L.F
-        dRw = L.dJ @ x - L.dF
         if not self.nl.n_nl:
             J[...] = L.J
-            return R, dRw
+            dRw[...] = L.dJ @ x - L.dF
+            return L.J @ x - L.F
         d = self.nl.dofs
         Xn = np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float)
         Fn, dFn, dFw = self.nl.evaluate(Xn, w)
         self._last_nl = (float(w), np.array(X, dtype=float), Fn)
-        if self._nl_all:
-            R += Fn.reshape(-1)
-            dRw += dFw.reshape(-1)
-            np.add(L.J, dFn, out=J)
-            return R, dRw
-        Rv, dRv = R.reshape(X.shape), dRw.reshape(X.shape)
-        Rv[:, d] += Fn
-        dRv[:, d] += dFw
-        J[...] = L.J
-        J[self._nl_ix] += dFn
-        return R, dRw
+        if not self._nl_all:        # scatter onto every contact coordinate (zeros elsewhere)
+            nco, n = X.shape
+            Fa, dFa = np.zeros((nco, n)), np.zeros((nco, n))
+            Fa[:, d], dFa[:, d] = Fn, dFw
+            Ja = np.zeros((nco * n, nco * n))
+            Ja[self._nl_ix] = dFn
+            Fn, dFw, dFn = Fa, dFa, Ja
+        R = np.empty(x.size)
+        assemble(L.J, L.dJ, L.F, L.dF, np.ascontiguousarray(x, dtype=float), Fn.reshape(-1), dFn,
+                 dFw.reshape(-1), J, R, dRw)
+        return R
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
         """``F_nl`` on the contact coordinates, (n_coef, n_c).
@@ -361,15 +360,18 @@ class CondensedHarmonicBalance:
         Re-uses the forces of the last residual evaluation when ``X`` and ``w`` are exactly
         its own (then they are the same numbers); otherwise runs the AFT (forces only).
         """
-        F = np.zeros_like(X, dtype=float)
         if not self.nl.n_nl:
-            return F
+            return np.zeros_like(X, dtype=float)
         d = self.nl.dofs
         last = self._last_nl
-        if last is not None and last[0] == float(w) and np.array_equal(last[1], X):
-            F[:, d] = last[2]
+        if last is not None and last[0] == float(w) and last[1].shape == X.shape and bool((last[1] == X).all()):
+            Fn = last[2].copy()
         else:
-            F[:, d] = self.nl.forces(np.ascontiguousarray(X[:, d]), w)
+            Fn = self.nl.forces(np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float), w)
+        if self._nl_all:
+            return Fn
+        F = np.zeros_like(X, dtype=float)
+        F[:, d] = Fn
         return F
 
     def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
@@ -443,28 +445,29 @@ class CondensedHarmonicBalance:
         """Work per period of the excitation, the viscous and the nonlinear forces (module doc).
 
         In complex form per harmonic (``X_h = Xc - i Xs``, velocity ``i h w X_h``), the work of
-        ``F`` on the motion ``Y`` over a period is ``-pi sum_h h Im(conj(F_h) Y_h)``.
+        ``F`` on the motion ``Y`` over a period is ``-pi sum_h h Im(conj(F_h) Y_h)``; for the unit
+        cosine excitation at harmonic 1 that is ``-pi Im(y_e)`` with ``y_e`` the excitation
+        coordinate's harmonic-1 amplitude.
         """
         r = self.reduced
         L = self._linear(w)
         fp = self._implied_forces(X, L)
         w_nl = np.pi * float(np.vdot(self.nonlinear_forces(X, w), self.basis.D @ X))
-        # excitation coordinate y_e = H_ee F_e - H_ec F'
-        se, sc = self._sl["e"], self._sl["c"]
-        fe = self._Fe_c
-        ye = (L.H[:, se, se] @ fe[:, :, None] - L.H[:, se, sc] @ fp[:, :, None])[:, :, 0]
-        w_ex = -np.pi * float(np.sum(self._h[:, None] * (fe.conj() * ye).imag))
-        # modal amplitudes of the structure under F_e and -F' (the mean does no work: W = 0)
+        i1, e, nc = self._i1, self._sl["e"].start, self.n_dof
+        ye = L.H[i1, e, e] - L.H[i1, e, :nc] @ fp[i1]               # y_e = H_ee F_e - H_ec F'
+        w_ex = -np.pi * float(ye.imag)
+        # modal amplitudes under F_e and -F' (the mean, W = 0, does no work)
         W = self._h * w
-        g = fe @ self._phi["e"] - fp @ self._phi["c"]                       # (n_h, m)
+        iW = (1j * W)[:, None]
+        g = self._ge - fp @ self._phi["c"]                           # (n_h, m)
         Cm = r.modal_c
         if r.proportional:
-            eta = g / (self._om2[None, :] - (W * W)[:, None] + 1j * W[:, None] * self._cdiag[None, :])
+            eta = g / (self._om2 - (W * W)[:, None] + iW * self._cdiag)
         else:
-            D = 1j * W[:, None, None] * Cm[None, :, :]
+            D = iW[:, :, None] * Cm
             ar = np.arange(self._om2.size)
-            D[:, ar, ar] += self._om2[None, :] - (W * W)[:, None]
+            D[:, ar, ar] += self._om2 - (W * W)[:, None]
             eta = np.linalg.solve(D, g[:, :, None])[:, :, 0]
-        v = 1j * W[:, None] * eta
-        w_v = float(np.real(np.vdot(v, v @ Cm.T)))
+        v = iW * eta
+        w_v = float(np.vdot(v, v @ Cm.T).real)
         return EnergyBalance(w_ex, np.pi / w * w_v, w_nl)

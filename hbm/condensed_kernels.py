@@ -215,3 +215,33 @@ def proportional_linear(Pu, ia, ib, p, om2, c, Ru, hs, w, rows, nc, ie, i1):
     H, dH = modal_receptances(Pu, ia, ib, p, om2, c, Ru, hs * w)
     ok, Z, JJ, FF = condensed_linear(H, dH, hs, rows, nc, ie, i1)
     return ok, H, dH, Z, JJ, FF
+
+
+@nb.njit(cache=True)
+def assemble(J0, dJ0, F0, dF0, x, Fn, dFn, dFw, J, R, dRw):
+    """Residual ``R = J0 x - F0 + Fn``, ``dR/dw = dJ0 x - dF0 + dFw`` and ``J = J0 + dFn``, written
+    into ``J`` (n_u, n_u), ``R`` and ``dRw`` (n_u,) (views allowed).
+
+    Parameters
+    ----------
+    J0, dJ0 : ndarray, shape (n_u, n_u)
+        Linear part and its ``w``-derivative (:func:`condensed_linear`).
+    F0, dF0 : ndarray, shape (n_u,)
+        Equivalent load and its ``w``-derivative.
+    x : ndarray, shape (n_u,)
+        Unknowns.
+    Fn, dFw : ndarray, shape (n_u,)
+        Nonlinear forces and their ``w``-derivative on all unknowns.
+    dFn : ndarray, shape (n_u, n_u)
+        Their Jacobian.
+    """
+    n = x.size
+    for i in range(n):
+        r = 0.0
+        dr = 0.0
+        for j in range(n):
+            r += J0[i, j] * x[j]
+            dr += dJ0[i, j] * x[j]
+            J[i, j] = J0[i, j] + dFn[i, j]
+        R[i] = (r - F0[i]) + Fn[i]
+        dRw[i] = (dr - dF0[i]) + dFw[i]
