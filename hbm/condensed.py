@@ -39,13 +39,15 @@ the same check as the full model's (there ``-W[R, \dot X]``).
 from __future__ import annotations
 
 import copy
+from typing import NamedTuple
 
 import numpy as np
 
 from .aft import NonlinearForces
-from .energy import EnergyBalance, work
+from .energy import EnergyBalance
 from .fourier import FourierBasis
-from .reduction import ReducedModel, apply_blocks, condense, real_block
+from .condensed_kernels import assemble, condensed_linear, modal_receptances, proportional_linear
+from .reduction import ReducedModel, condense, receptance_stack
 
 _RANK_TOL = 1e-10
 
@@ -104,9 +106,42 @@ def _regathered(element, A):
     return e
 
 
+class _LinearPart(NamedTuple):
+    """The linear part at one fundamental frequency ``w`` (see :meth:`CondensedHarmonicBalance._linear`).
+
+    Attributes
+    ----------
+    H, dH : ndarray, complex, shape (n_h, n_p, n_p)
+        Receptances and their ``W``-derivatives between all kept coordinates (contact,
+        excitation, output, in that order) at ``W = h w`` for every harmonic.
+    Z : ndarray, complex, shape (n_h, n_c, n_c)
+        ``Z_c(h w) = H_cc^{-1}``.
+    J, dJ : ndarray, shape (n_u, n_u)
+        ``dR/dU`` of the linear part (``Z_c`` in real block form on the unknown vector) and its
+        ``w``-derivative (``h dZ_c/dW`` per harmonic).
+    F, dF : ndarray, shape (n_u,)
+        Equivalent contact load ``F_eq`` and ``dF_eq/dw``, flattened like the unknowns.
+    """
+
+    H: np.ndarray
+    dH: np.ndarray
+    Z: np.ndarray
+    J: np.ndarray
+    dJ: np.ndarray
+    F: np.ndarray
+    dF: np.ndarray
+
+
 class CondensedHarmonicBalance:
     """Residual ``R(U, w)`` on the contact coordinates (module docstring); the interface of
     :class:`hbm.residual.HarmonicBalance` used by :mod:`hbm.response` and :mod:`hbm.energy`.
+
+    Every harmonic is handled at once, in one compiled call (:mod:`hbm.condensed_kernels`):
+    the receptances of all kept coordinates from one product over the modes, ``Z_c`` per
+    harmonic, and the real Jacobian ``dR/dU`` of the linear part with its ``w``-derivative, so
+    that a residual is two matrix-vector products plus the AFT.  The linear part is memoised
+    for the last ``w`` and the nonlinear forces for the last residual evaluation (exact ``X``
+    and ``w`` only: re-used, they are the same numbers).
 
     Parameters
     ----------
@@ -152,30 +187,52 @@ class CondensedHarmonicBalance:
         self.reduced = reduced
         self.contact_rows = G_c
         self.output_rows = G_o
-        self.condensed = condense(reduced, G_c, G_o, G_e)
+        self.condensed = cm = condense(reduced, G_c, G_o, G_e)
         nc = G_c.shape[0]
         self.n_dof = nc
         self.nl = NonlinearForces(basis, elems, nc, transform)
-        F_e = np.zeros((basis.n_coef, 1))
+        nco = basis.n_coef
+        F_e = np.zeros((nco, 1))
         F_e[basis.row_of(1, "c"), 0] = 1.0
         self.F_e = F_e
-        self._slices = []
-        r = 0
-        for h in basis.harmonics:
-            nr = 1 if h == 0 else 2
-            self._slices.append(slice(r * nc, (r + nr) * nc))
-            r += nr
-        self._nl_index = (np.arange(basis.n_coef)[:, None] * nc + self.nl.dofs[None, :]).ravel()
-        cg = {"c": self.condensed.G_c, "e": self.condensed.G_e, "o": self.condensed.G_o}
-        self._phi = {k: G @ reduced.phi for k, G in cg.items()}
-        self._R = {a + b: cg[a] @ reduced.residual @ cg[b].T for a, b in ("cc", "ce", "ee", "ec", "oc", "oe")}
-        self._outer = {}
-        self._c = np.ascontiguousarray(np.diag(reduced.modal_c))
-        self._h = np.asarray(basis.harmonics, dtype=float)
-        self._i1 = int(np.flatnonzero(basis.harmonics == 1)[0])
-        self._rows = [basis.row_of(int(h), "c") for h in basis.harmonics]
+        # all kept coordinates stacked: contact, excitation, output
+        G_all = np.vstack([cm.G_c, cm.G_e, cm.G_o])
+        ne, no = cm.G_e.shape[0], cm.G_o.shape[0]
+        self._sl = {"c": slice(0, nc), "e": slice(nc, nc + ne), "o": slice(nc + ne, nc + ne + no)}
+        self._phi_all = G_all @ reduced.phi
+        self._R_all = G_all @ reduced.residual @ G_all.T
+        self._om2 = np.ascontiguousarray(reduced.omega ** 2)
+        self._cdiag = np.ascontiguousarray(np.diag(reduced.modal_c))
+        ia, ib = np.triu_indices(self._phi_all.shape[0])
+        self._tri = (ia.astype(np.int64), ib.astype(np.int64))
+        self._Pu = np.ascontiguousarray(self._phi_all[ia].T * self._phi_all[ib].T)   # (m, n_t)
+        self._Ru = np.ascontiguousarray(self._R_all[ia, ib])
+        self._phi = {k: self._phi_all[s] for k, s in self._sl.items()}
+        # harmonic rows: cosine (or mean) row of every harmonic, sine rows of h > 0
+        h = np.asarray(basis.harmonics)
+        self._h = h.astype(float)
+        self._i1 = int(np.flatnonzero(h == 1)[0])
+        self._rc = np.array([basis.row_of(int(k), "c") for k in h])
+        self._pos = np.flatnonzero(h > 0)
+        self._zero = np.flatnonzero(h == 0)
+        self._rs = self._rc[self._pos] + 1
+        # complex amplitudes Xc - i Xs per harmonic from real coefficients and back, as products
+        to_c = np.zeros((h.size, nco), dtype=complex)
+        to_c[np.arange(h.size), self._rc] = 1.0
+        to_c[self._pos, self._rs] = -1j
+        to_r = np.zeros((nco, h.size), dtype=complex)
+        to_r[self._rc, np.arange(h.size)] = 1.0
+        to_r[self._rs, self._pos] = 1j
+        self._to_c, self._to_r = to_c, to_r
+        self._Fe_c = self._complex(F_e)
+        self._ge = self._Fe_c @ self._phi["e"]          # Phi^T G_e^T F_e per harmonic, (n_h, m)
+        d = self.nl.dofs
+        self._nl_all = d.size == nc
+        idx = (np.arange(nco)[:, None] * nc + d[None, :]).ravel()
+        self._nl_ix = np.ix_(idx, idx)
         self._memo_w = None
         self._memo = None
+        self._last_nl = None
 
     @property
     def n_unknowns(self) -> int:
@@ -198,69 +255,53 @@ class CondensedHarmonicBalance:
         """Coefficients (n_coef, n_c) -> unknown vector (n_coef * n_c,)."""
         return X.reshape(-1).copy()
 
-    # ------------------------------------------------------------------ linear part
-    def _receptances(self, a: str, b: str, Ws: np.ndarray):
-        """``H_ab(W)`` and ``dH_ab/dW`` for all ``Ws`` at once, (n_W, n_a, n_b) complex."""
-        r = self.reduced
-        pa, pb = self._phi[a], self._phi[b]
-        Rab = self._R[a + b]
-        om2 = r.omega ** 2
-        if r.proportional:
-            # H_ab(W) = sum_r P_r / d_r(W) + R_ab with P_r = phi_a[:, r] phi_b[:, r]^T: one product
-            P = self._outer.get(a + b)
-            if P is None:
-                P = self._outer[a + b] = np.einsum("ir,jr->rij", pa, pb).reshape(om2.size, -1)
-            c = self._c
-            d = om2[None, :] - Ws[:, None] ** 2 + 1j * Ws[:, None] * c[None, :]
-            inv = 1.0 / d
-            dinv = (2.0 * Ws[:, None] - 1j * c[None, :]) * inv * inv
-            shape = (Ws.size, pa.shape[0], pb.shape[0])
-            H = (inv @ P).reshape(shape) + Rab
-            dH = (dinv @ P).reshape(shape)
-            return H, dH
-        H = np.empty((Ws.size, pa.shape[0], pb.shape[0]), dtype=complex)
-        dH = np.empty_like(H)
-        for i, W in enumerate(Ws):
-            H[i], dH[i] = self.condensed.receptance(a, b, W)
-        return H, dH
+    # ------------------------------------------------------------------ complex form
+    def _complex(self, X: np.ndarray) -> np.ndarray:
+        """Real coefficients (n_coef, q) -> complex amplitudes ``Xc - i Xs`` per harmonic (n_h, q)."""
+        return self._to_c @ X
 
-    def _linear(self, w: float):
-        """``Z_c``, ``dZ_c/dW`` per harmonic (n_h, n_c, n_c) complex, and ``F_eq``, ``dF_eq/dw``
-        (n_coef, n_c).
+    def _real(self, Y: np.ndarray) -> np.ndarray:
+        """Complex amplitudes per harmonic (n_h, q) -> real coefficients (n_coef, q):
+        ``Xc = Re Y``, ``Xs = Re(i Y) = -Im Y``."""
+        return (self._to_r @ Y).real
+
+    # ------------------------------------------------------------------ linear part
+    def _receptances(self, Ws: np.ndarray):
+        """``H(W)`` and ``dH/dW`` between all kept coordinates, (n_W, n_p, n_p) complex."""
+        r = self.reduced
+        Ws = np.ascontiguousarray(Ws, dtype=float)
+        if r.proportional:
+            return modal_receptances(self._Pu, *self._tri, self._phi_all.shape[0], self._om2,
+                                     self._cdiag, self._Ru, Ws)
+        H, dH = receptance_stack(self._phi_all, r.omega, r.modal_c, False, self._R_all, Ws)
+        return np.ascontiguousarray(H), np.ascontiguousarray(dH)
+
+    def _linear(self, w: float) -> _LinearPart:
+        """The linear part at ``w`` (:class:`_LinearPart`), from one compiled call
+        (:mod:`hbm.condensed_kernels`).
 
         Memoised for the last ``w`` only (Newton at a fixed frequency re-uses it).
         """
         w = float(w)
         if self._memo_w == w:
             return self._memo
-        Ws = self._h * w
-        Hcc, dHcc = self._receptances("c", "c", Ws)
-        try:
-            Z = np.linalg.inv(Hcc)
-        except np.linalg.LinAlgError:
-            raise ValueError("contact receptance is singular (dependent contact coordinates?)") from None
-        dZ = -Z @ dHcc @ Z
-        F = np.zeros((self.basis.n_coef, self.n_dof))
-        dF = np.zeros_like(F)
-        i1 = self._i1
-        Hce, dHce = self._receptances("c", "e", Ws[i1:i1 + 1])
-        t = Z[i1] @ Hce[0, :, 0]                       # unit cosine force at harmonic 1
-        dt = dZ[i1] @ Hce[0, :, 0] + Z[i1] @ dHce[0, :, 0]
-        k = self.basis.row_of(1, "c")
-        F[k], F[k + 1] = t.real, -t.imag               # Fc - i Fs = t
-        dF[k], dF[k + 1] = dt.real, -dt.imag
-        self._memo_w, self._memo = w, (Z, dZ, F, dF)
+        rows, nc, ie, i1 = self._rc, self.n_dof, self._sl["e"].start, self._i1
+        if self.reduced.proportional:
+            ok, H, dH, Z, JJ, FF = proportional_linear(
+                self._Pu, *self._tri, self._phi_all.shape[0], self._om2, self._cdiag, self._Ru,
+                self._h, w, rows, nc, ie, i1)
+        else:
+            H, dH = self._receptances(self._h * w)
+            ok, Z, JJ, FF = condensed_linear(H, dH, self._h, rows, nc, ie, i1)
+        if not ok:
+            raise ValueError("contact receptance is singular (dependent contact coordinates?)")
+        self._memo = _LinearPart(H, dH, Z, JJ[0], JJ[1], FF[0], FF[1])
+        self._memo_w = w
         return self._memo
-
-    def _blocks(self, w: float):
-        """Real blocks ``Z_h`` per harmonic, as :func:`hbm.linear.harmonic_blocks` lays them out."""
-        Z = self._linear(w)[0]
-        return [np.ascontiguousarray(z.real) if h == 0 else real_block(z)
-                for h, z in zip(self.basis.harmonics, Z)]
 
     def load(self, w: float) -> np.ndarray:
         """Equivalent contact load ``F_eq(w)`` (n_coef, n_c)."""
-        return self._linear(w)[2]
+        return self._linear(w).F.reshape(self.basis.n_coef, self.n_dof).copy()
 
     # ------------------------------------------------------------------ residual
     def residual(self, X: np.ndarray, w: float):
@@ -277,66 +318,75 @@ class CondensedHarmonicBalance:
         dRdX : ndarray, shape (n_u, n_u)
         dRdw : ndarray, shape (n_u,)
         """
-        Z, dZ, F, dF = self._linear(w)
-        n = self.n_dof
-        R = -F.copy()
-        dRw = -dF.copy()
-        J = np.zeros((X.size, X.size))
-        Jv = J.reshape(self.basis.n_coef, n, self.basis.n_coef, n)
-        for h, kc, z, dz in zip(self.basis.harmonics, self._rows, Z, dZ):
-            if h == 0:
-                R[kc] += z.real @ X[kc]
-                Jv[kc, :, kc, :] = z.real
-                continue
-            ks = kc + 1
-            u = X[kc] - 1j * X[ks]
-            zu = z @ u
-            dzu = h * (dz @ u)
-            R[kc] += zu.real
-            R[ks] -= zu.imag
-            dRw[kc] += dzu.real
-            dRw[ks] -= dzu.imag
-            Jv[kc, :, kc, :] = z.real
-            Jv[kc, :, ks, :] = z.imag
-            Jv[ks, :, kc, :] = -z.imag
-            Jv[ks, :, ks, :] = z.real
-        if self.nl.n_nl:
-            d = self.nl.dofs
-            Fn, dFn, dFw = self.nl.evaluate(np.ascontiguousarray(X[:, d]), w)
-            R[:, d] += Fn
-            dRw[:, d] += dFw
-            J[np.ix_(self._nl_index, self._nl_index)] += dFn
-        return R.reshape(-1), J, dRw.reshape(-1)
+        nu = self.n_unknowns
+        J, dRw = np.empty((nu, nu)), np.empty(nu)
+        R = self._evaluate(X, w, J, dRw)
+        return R, J, dRw
 
     def __call__(self, x: np.ndarray):
         """Continuation form: ``x = [U.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dU, dR/dw]`` (n_u, n_u + 1)."""
-        X = x[:-1].reshape(self.basis.n_coef, self.n_dof)
-        R, J, dw = self.residual(X, float(x[-1]))
-        return R, np.hstack([J, dw[:, None]])
+        nu = self.n_unknowns
+        A = np.empty((nu, nu + 1))
+        R = self._evaluate(x[:-1].reshape(self.basis.n_coef, self.n_dof), float(x[-1]), A[:, :nu], A[:, nu])
+        return R, A
+
+    def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray, dRw: np.ndarray) -> np.ndarray:
+        """``R`` (n_u,) returned; ``dR/dU`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw`` (n_u,)."""
+        L = self._linear(w)
+        x = X.reshape(-1)
+        if not self.nl.n_nl:
+            J[...] = L.J
+            dRw[...] = L.dJ @ x - L.dF
+            return L.J @ x - L.F
+        d = self.nl.dofs
+        Xn = np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float)
+        Fn, dFn, dFw = self.nl.evaluate(Xn, w)
+        self._last_nl = (float(w), np.array(X, dtype=float), Fn)
+        if not self._nl_all:        # scatter onto every contact coordinate (zeros elsewhere)
+            nco, n = X.shape
+            Fa, dFa = np.zeros((nco, n)), np.zeros((nco, n))
+            Fa[:, d], dFa[:, d] = Fn, dFw
+            Ja = np.zeros((nco * n, nco * n))
+            Ja[self._nl_ix] = dFn
+            Fn, dFw, dFn = Fa, dFa, Ja
+        R = np.empty(x.size)
+        assemble(L.J, L.dJ, L.F, L.dF, np.ascontiguousarray(x, dtype=float), Fn.reshape(-1), dFn,
+                 dFw.reshape(-1), J, R, dRw)
+        return R
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
-        """``F_nl`` on the contact coordinates, (n_coef, n_c)."""
-        F = np.zeros_like(X)
-        if self.nl.n_nl:
-            F[:, self.nl.dofs] = self.nl.forces(np.ascontiguousarray(X[:, self.nl.dofs]), w)
+        """``F_nl`` on the contact coordinates, (n_coef, n_c).
+
+        Re-uses the forces of the last residual evaluation when ``X`` and ``w`` are exactly
+        its own (then they are the same numbers); otherwise runs the AFT (forces only).
+        """
+        if not self.nl.n_nl:
+            return np.zeros_like(X, dtype=float)
+        d = self.nl.dofs
+        last = self._last_nl
+        if last is not None and last[0] == float(w) and last[1].shape == X.shape and bool((last[1] == X).all()):
+            Fn = last[2].copy()
+        else:
+            Fn = self.nl.forces(np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float), w)
+        if self._nl_all:
+            return Fn
+        F = np.zeros_like(X, dtype=float)
+        F[:, d] = Fn
         return F
 
     def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
         """Solution of ``(Z_c(w) + K_extra) U = F_eq(w)`` (n_coef, n_c): the start of Newton.
 
         ``extra_stiffness`` (n_c, n_c) adds e.g. the stuck stiffness of the elements.
+        Per harmonic in complex form (a real ``K_extra`` adds to the real part of ``Z_c``).
         """
-        blocks, F = self._blocks(w), self._linear(w)[2]
-        X = np.zeros_like(F)
-        f, x = F.reshape(-1), X.reshape(-1)
-        n = self.n_dof
-        for s, B in zip(self._slices, blocks):
-            if not np.any(f[s]):
-                continue
-            if extra_stiffness is not None:
-                B = B + np.kron(np.eye(B.shape[0] // n), extra_stiffness)
-            x[s] = np.linalg.solve(B, f[s])
-        return X
+        L = self._linear(w)
+        Z = L.Z if extra_stiffness is None else L.Z + np.asarray(extra_stiffness, dtype=float)
+        f = self._complex(L.F.reshape(self.basis.n_coef, self.n_dof))
+        u = np.zeros_like(f)
+        for i in np.flatnonzero(np.any(f != 0.0, axis=1)):
+            u[i] = np.linalg.solve(Z[i], f[i])
+        return self._real(u)
 
     def stuck_stiffness(self) -> np.ndarray:
         """Tangent stiffness of the elements at rest on the contact coordinates, (n_c, n_c)."""
@@ -352,70 +402,72 @@ class CondensedHarmonicBalance:
         -------
         free, stuck : ndarray, shape (n_c,)
         """
-        cm = self.condensed
         Ks = self.stuck_stiffness() if stuck_stiffness is None else stuck_stiffness
-        free = np.zeros(self.n_dof)
-        stuck = np.zeros(self.n_dof)
-        for w in ws:
-            Hcc, _ = cm.receptance("c", "c", w)
-            Hce, _ = cm.receptance("c", "e", w)
-            u = Hce[:, 0]
-            np.maximum(free, np.abs(u), out=free)
-            try:
-                us = np.linalg.solve(np.eye(self.n_dof) + Hcc @ Ks, u)
-            except np.linalg.LinAlgError:
-                continue
-            np.maximum(stuck, np.abs(us), out=stuck)
+        ws = np.atleast_1d(np.asarray(ws, dtype=float))
+        H, _ = self._receptances(ws)
+        c, e = self._sl["c"], self._sl["e"]
+        u = H[:, c, e][:, :, 0]                              # (n_w, n_c)
+        free = np.max(np.abs(u), axis=0, initial=0.0)
+        A = np.eye(self.n_dof) + H[:, c, c] @ Ks
+        try:
+            us = np.linalg.solve(A, u[:, :, None])[:, :, 0]
+        except np.linalg.LinAlgError:                        # skip the singular frequencies
+            us = np.zeros_like(u)
+            for i in range(ws.size):
+                try:
+                    us[i] = np.linalg.solve(A[i], u[i])
+                except np.linalg.LinAlgError:
+                    pass
+        stuck = np.max(np.abs(us), axis=0, initial=0.0)
         return free, stuck
 
     # ------------------------------------------------------------------ outputs and energy
-    def _implied_forces(self, X: np.ndarray, w: float) -> np.ndarray:
-        """Contact forces implied by the linear part, ``F' = F_eq - Z_c U`` (n_coef, n_c)."""
-        return self._linear(w)[2] - apply_blocks(self._blocks(w), self.basis, X)
+    def _implied_forces(self, X: np.ndarray, L: _LinearPart) -> np.ndarray:
+        """Contact forces implied by the linear part, ``F' = F_eq - Z_c U``, per harmonic (n_h, n_c) complex."""
+        Fp = (L.F - L.J @ X.reshape(-1)).reshape(X.shape)
+        return self._complex(Fp)
 
-    def _respond(self, a: str, X: np.ndarray, w: float) -> np.ndarray:
-        """Response ``y_a = H_ae F_e - H_ac F'`` (n_coef, n_a) of coordinates ``a`` (``'e'``, ``'o'``)."""
-        Fp = self._implied_forces(X, w)
-        Ws = self._h * w
-        Hae, _ = self._receptances(a, "e", Ws)
-        Hac, _ = self._receptances(a, "c", Ws)
-        Y = np.zeros((self.basis.n_coef, Hae.shape[1]))
-        for i, (h, kc) in enumerate(zip(self.basis.harmonics, self._rows)):
-            if h == 0:
-                Y[kc] = Hae[i].real @ self.F_e[kc] - Hac[i].real @ Fp[kc]
-                continue
-            y = Hae[i] @ (self.F_e[kc] - 1j * self.F_e[kc + 1]) - Hac[i] @ (Fp[kc] - 1j * Fp[kc + 1])
-            Y[kc], Y[kc + 1] = y.real, -y.imag
-        return Y
+    def _respond(self, a: str, fp: np.ndarray, L: _LinearPart) -> np.ndarray:
+        """Response ``y_a = H_ae F_e - H_ac F'`` (n_coef, n_a) of coordinates ``a`` (``'e'``, ``'o'``)
+        to the implied contact forces ``fp`` (n_h, n_c) complex."""
+        sa, sc, se = self._sl[a], self._sl["c"], self._sl["e"]
+        y = (L.H[:, sa, se] @ self._Fe_c[:, :, None] - L.H[:, sa, sc] @ fp[:, :, None])[:, :, 0]
+        return self._real(y)
 
     def recover_outputs(self, X: np.ndarray, w: float) -> np.ndarray:
         """Output coefficients ``Y = H_oe F_e - H_oc F'`` (n_coef, n_o) from the contact
         coefficients ``X`` (n_coef, n_c); equal to ``T_oc U + T_oe F_e`` of
         :meth:`hbm.reduction.CondensedModel.recover_outputs`."""
-        return self._respond("o", X, w)
+        L = self._linear(w)
+        return self._respond("o", self._implied_forces(X, L), L)
 
     def energy_balance(self, X: np.ndarray, w: float) -> EnergyBalance:
-        """Work per period of the excitation, the viscous and the nonlinear forces (module doc)."""
-        basis = self.basis
+        """Work per period of the excitation, the viscous and the nonlinear forces (module doc).
+
+        In complex form per harmonic (``X_h = Xc - i Xs``, velocity ``i h w X_h``), the work of
+        ``F`` on the motion ``Y`` over a period is ``-pi sum_h h Im(conj(F_h) Y_h)``; for the unit
+        cosine excitation at harmonic 1 that is ``-pi Im(y_e)`` with ``y_e`` the excitation
+        coordinate's harmonic-1 amplitude.
+        """
         r = self.reduced
-        Fp = self._implied_forces(X, w)
-        V = w * (basis.D @ X)
-        w_nl = work(basis, self.nonlinear_forces(X, w), V, w)
-        w_ex = work(basis, self.F_e, w * (basis.D @ self._respond("e", X, w)), w)
-        w_v = 0.0
+        L = self._linear(w)
+        fp = self._implied_forces(X, L)
+        w_nl = np.pi * float(np.vdot(self.nonlinear_forces(X, w), self.basis.D @ X))
+        i1, e, nc = self._i1, self._sl["e"].start, self.n_dof
+        ye = L.H[i1, e, e] - L.H[i1, e, :nc] @ fp[i1]               # y_e = H_ee F_e - H_ec F'
+        w_ex = -np.pi * float(ye.imag)
+        # modal amplitudes under F_e and -F' (the mean, W = 0, does no work)
+        W = self._h * w
+        iW = (1j * W)[:, None]
+        g = self._ge - fp @ self._phi["c"]                           # (n_h, m)
         Cm = r.modal_c
-        om2 = r.omega ** 2
-        for h, kc in zip(basis.harmonics, self._rows):
-            if h == 0:
-                continue
-            W = h * w
-            fc = Fp[kc] - 1j * Fp[kc + 1]
-            fe = self.F_e[kc] - 1j * self.F_e[kc + 1]
-            g = self._phi["e"].T @ fe - self._phi["c"].T @ fc
-            if r.proportional:
-                eta = g / (om2 - W * W + 1j * W * np.diag(Cm))
-            else:
-                eta = np.linalg.solve(np.diag(om2 - W * W) + 1j * W * Cm, g)
-            v = 1j * W * eta
-            w_v += float(np.real(np.vdot(v, Cm @ v)))
+        if r.proportional:
+            eta = g / (self._om2 - (W * W)[:, None] + iW * self._cdiag)
+        else:
+            D = iW[:, :, None] * Cm
+            ar = np.arange(self._om2.size)
+            D[:, ar, ar] += self._om2 - (W * W)[:, None]
+            eta = np.linalg.solve(D, g[:, :, None])[:, :, 0]
+        v = iW * eta
+        w_v = float(np.vdot(v, v @ Cm.T).real)
         return EnergyBalance(w_ex, np.pi / w * w_v, w_nl)

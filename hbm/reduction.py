@@ -96,7 +96,13 @@ def real_block(Hc: np.ndarray) -> np.ndarray:
     ndarray, shape (2p, 2q)
     """
     a, b = Hc.real, Hc.imag
-    return np.block([[a, b], [-b, a]])
+    p, q = a.shape
+    out = np.empty((2 * p, 2 * q))
+    out[:p, :q] = a
+    out[:p, q:] = b
+    out[p:, :q] = -b
+    out[p:, q:] = a
+    return out
 
 
 def apply_blocks(blocks, basis: FourierBasis, X: np.ndarray) -> np.ndarray:
@@ -221,6 +227,52 @@ def _receptance(phi_a, phi_b, omega, modal_c, proportional, R_ab, W):
         dD = -2.0 * W * np.eye(omega.size) + 1j * modal_c
         Za = sla.lu_solve(lu, phi_a.T.astype(complex), trans=1)  # D^-T phi_a^T
         dH = -(Za.T @ (dD @ Y))
+    return H, dH
+
+
+def receptance_stack(phi, omega, modal_c, proportional, R, Ws):
+    """``H(W) = phi D(W)^{-1} phi^T + R`` and ``dH/dW`` for many ``W`` at once (complex).
+
+    Parameters
+    ----------
+    phi : ndarray, shape (p, m)
+        Mode shapes at the ``p`` coordinates of interest (e.g. ``G phi`` for gather rows ``G``).
+    omega : ndarray, shape (m,)
+    modal_c : ndarray, shape (m, m)
+    proportional : bool
+        ``modal_c`` is diagonal: ``H = sum_r phi_r phi_r^T / d_r(W) + R``, one product for all ``W``.
+    R : ndarray, shape (p, p)
+        Residual flexibility at the coordinates.
+    Ws : ndarray, shape (n_W,)
+        Angular frequencies, rad/s.
+
+    Returns
+    -------
+    H, dH : ndarray, complex, shape (n_W, p, p)
+    """
+    Ws = np.asarray(Ws, dtype=float)
+    p, m = phi.shape
+    om2 = omega * omega
+    k = Ws.size
+    if proportional:
+        outer = np.einsum("ir,jr->rij", phi, phi).reshape(m, p * p)
+        c = np.diag(modal_c)
+        inv = 1.0 / (om2[None, :] - Ws[:, None] ** 2 + 1j * Ws[:, None] * c[None, :])
+        dinv = (2.0 * Ws[:, None] - 1j * c[None, :]) * inv * inv
+        HdH = np.concatenate([inv, dinv]) @ outer            # (2 n_W, p * p), one product
+        H = HdH[:k].reshape(k, p, p) + R
+        return H, HdH[k:].reshape(k, p, p)
+    D = 1j * Ws[:, None, None] * modal_c[None, :, :]
+    ar = np.arange(m)
+    D[:, ar, ar] += om2[None, :] - Ws[:, None] ** 2
+    phiT = np.broadcast_to(phi.T.astype(complex), (k, m, p))
+    Y = np.linalg.solve(D, phiT)                               # D^-1 phi^T
+    Za = np.linalg.solve(D.transpose(0, 2, 1), phiT)           # D^-T phi^T
+    dD = np.empty((k, m, m), dtype=complex)
+    dD[:] = 1j * modal_c
+    dD[:, ar, ar] -= 2.0 * Ws[:, None]
+    H = phi @ Y + R
+    dH = -(Za.transpose(0, 2, 1) @ (dD @ Y))
     return H, dH
 
 
