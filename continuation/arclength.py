@@ -76,6 +76,11 @@ def default_scale(x0: np.ndarray, lam_bounds: tuple[float, float]) -> np.ndarray
     return s
 
 
+def _norm(v: np.ndarray) -> float:
+    """Euclidean norm of a vector (``np.linalg.norm`` without its wrapping cost)."""
+    return math.sqrt(float(v @ v))
+
+
 class Arclength:
     """Pseudo-arclength continuation; iterate it to get :class:`ContinuationPoint` objects.
 
@@ -150,21 +155,22 @@ class Arclength:
 
     # ------------------------------------------------------------------ evaluation
     def _evaluate(self, xs: np.ndarray) -> Evaluation:
+        """One call of ``fun`` (inside :meth:`_correct`'s ``errstate``: NaN/inf are results)."""
         self.n_eval += 1
         n = xs.size - 1
-        with np.errstate(all="ignore"):
-            R, J = self.fun(xs * self.scale)
-            R = np.asarray(R, dtype=float).reshape(-1)
-            J = np.asarray(J, dtype=float)
-            if R.shape != (n,) or J.shape != (n, n + 1):
-                raise ValueError(f"fun must return R shape ({n},) and J shape ({n}, {n + 1}), "
-                                 f"got {R.shape} and {J.shape}")
-            return Evaluation(xs.copy(), R, J * self.scale[None, :])
+        R, J = self.fun(xs * self.scale)
+        R = np.asarray(R, dtype=float).reshape(-1)
+        J = np.asarray(J, dtype=float)
+        if R.shape != (n,) or J.shape != (n, n + 1):
+            raise ValueError(f"fun must return R shape ({n},) and J shape ({n}, {n + 1}), "
+                             f"got {R.shape} and {J.shape}")
+        return Evaluation(xs.copy(), R, J * self.scale)
 
     def _correct(self, xs0, constraint) -> Correction:
         o = self.options
-        return correct(self._evaluate, xs0, constraint, self._rho0, o.tol, o.max_iter,
-                       o.max_backtrack)
+        with np.errstate(all="ignore"):
+            return correct(self._evaluate, xs0, constraint, self._rho0, o.tol, o.max_iter,
+                           o.max_backtrack)
 
     def _fixed_lam(self, xs0: np.ndarray, lam_s: float) -> Correction:
         e = np.zeros_like(xs0)
@@ -259,7 +265,7 @@ class Arclength:
             fold = lam_prev_sign != 0 and np.sign(t_new[-1]) != 0 and \
                 np.sign(t_new[-1]) != lam_prev_sign
             if fold:
-                h = float(np.linalg.norm(c.xs - xs))
+                h = _norm(c.xs - xs)
                 lam_f = fold_parameter(xs[-1], c.xs[-1], t[-1], t_new[-1], h)
                 self.folds.append(float(lam_f * s_lam))
             if np.sign(t_new[-1]) != 0:
@@ -319,7 +325,7 @@ class Arclength:
         if not c.converged:
             return c, None, 0.0, f"Newton did not converge ({c.reason})", on_bound
         chord = c.xs - xs
-        chord_len = float(np.linalg.norm(chord))
+        chord_len = _norm(chord)
         along = float(chord @ t)
         if not chord_len > 0:
             return c, None, 0.0, "the corrector returned to the last point", on_bound
@@ -328,13 +334,13 @@ class Arclength:
                 return c, None, 0.0, "the corrector went back along the path", on_bound
         elif along <= 0:
             return c, None, 0.0, "the corrector went back along the path", on_bound
-        jump = float(np.linalg.norm(c.xs - start))
+        jump = _norm(c.xs - start)
         if not sphere and not on_bound and jump > o.max_correction * ds:
             return (c, None, 0.0,
                     f"the corrector moved {jump / ds:.2g} step lengths (branch jump)", on_bound)
         if c.null is not None and not sphere and not on_bound and np.isfinite(c.null).all() \
                 and np.any(c.null):
-            t_new = c.null / np.linalg.norm(c.null)    # the hyperplane's a is t: same system
+            t_new = c.null / _norm(c.null)    # the hyperplane's a is t: same system
         else:
             t_new = null_tangent(c.ev.Js, t)
         if t_new @ chord < 0:
