@@ -15,15 +15,16 @@ the same case (``REF``: H = 31, N = 2048, a dense path):
   window around the peak (so the error is that of H and N, not of the path's point spacing;
   the window is traced by arclength, so a peak at a fold is found as well);
 - whole-FRF error: the largest relative error of the first harmonic at the points of the
-  default path against the reference path (for paths that fold, the largest distance to the
-  reference curve: :func:`frf_error`).
+  default path against the reference path, relative to at least 1 % of the peak (for paths
+  that fold, the largest distance to the reference curve: :func:`frf_error`).
 
 Criterion: the issue asks for < 0.5 % peak error; with a safety factor of 5 the peak error
 must be below ``PEAK_TOL = 0.1 %``, and the whole-FRF error below ``FRF_TOL = 0.5 %`` (the peak
 alone is reached at H = 1 by most friction cases: the single-mode response filters the higher
 harmonics there, while the stick-slip transition off the peak needs more).  The chosen H and
-factor are the smallest H of the ladder meeting both at this H and at every larger H of the
-ladder with the same factor (factor 1 first at equal H).  An element type with several cases
+factor are the smallest H of the ladder meeting both, with a path that reaches the end of
+the frequency range, at this H and at every larger H of the ladder with the same factor
+(factor 1 first at equal H).  An element type with several cases
 takes the largest H and factor over them.  The table in ``elements/*.py``
 (``default_harmonics``, ``default_samples_factor``) holds the chosen values; this script
 prints them beside its own choice so that a drift shows.
@@ -70,6 +71,7 @@ from continuation import ArclengthOptions  # noqa: E402
 TARGET = 5e-3            # the issue's 0.5 % peak error
 PEAK_TOL = 1e-3          # 0.1 %: TARGET with a safety factor of 5
 FRF_TOL = 5e-3           # whole-FRF error: TARGET, no safety factor
+ANTI_FLOOR = 0.01        # FRF errors relative to at least 1 % of the peak (antiresonances)
 REF = (31, 2048)         # reference H, N
 REF_QUICK = (15, 512)
 QUICK_LADDER = (1, 3, 5, 7)
@@ -147,7 +149,9 @@ CASES = {
     "coulomb_stick_slip": [("sdof_stick_slip", stick_slip_case, {})],
     "coulomb_regularised": [("sdof_regularised", regularised_case, {})],
     "brush": [("inclined_brush", brush_case, {})],
-    "wedge_damper": [("blade_pair_wedge", wedge_case, {"quick": False})],
+    # its reference at H = 31, N = 2048 takes over 6 min: H = 21, N = 1024 and a ladder to 15
+    "wedge_damper": [("blade_pair_wedge", wedge_case,
+                      {"ref": (21, 1024), "ladder": LADDER[:-1], "quick": False})],
 }
 
 
@@ -163,19 +167,23 @@ def frf_error(res, ref, name):
     meaningless next to a fold (the curve is vertical there), so the largest distance of a
     point of ``res`` to the reference curve, the distance being the larger of the relative
     amplitude and relative frequency differences, minimised along the curve.  Points outside
-    the reference's frequency range are left out.
+    the reference's frequency range are left out.  Amplitudes are relative to the reference
+    amplitude, but not to less than ``ANTI_FLOOR`` times the reference peak: at an
+    antiresonance (the wedge case's driven blade at 115 Hz, 1/200 of its peak) a relative
+    error says little.
     """
     f, a = ref.freq_hz, ref.outputs[name].h1
+    floor = ANTI_FLOOR * a.max()
     fr, ar = res.freq_hz, res.outputs[name].h1
     inside = (fr >= f.min()) & (fr <= f.max())
     fr, ar = fr[inside], ar[inside]
     if np.all(np.diff(f) > 0) and np.all(np.diff(res.freq_hz) > 0):
         b = PchipInterpolator(f, a)(fr)
-        return float(np.max(np.abs(ar - b) / np.abs(b)))
+        return float(np.max(np.abs(ar - b) / np.maximum(np.abs(b), floor)))
     t = np.linspace(0.0, 1.0, 21)[:-1]
     fd = np.r_[(f[:-1, None] + np.diff(f)[:, None] * t).ravel(), f[-1]]     # 20 points per segment
     ad = np.r_[(a[:-1, None] + np.diff(a)[:, None] * t).ravel(), a[-1]]
-    d = np.maximum(np.abs(ar[:, None] - ad) / ad, np.abs(fr[:, None] - fd) / fd)
+    d = np.maximum(np.abs(ar[:, None] - ad) / np.maximum(ad, floor), np.abs(fr[:, None] - fd) / fd)
     return float(d.min(axis=1).max())
 
 
@@ -232,17 +240,22 @@ def zoomed_peak(case, name, coarse):
 def reference(make, ref_hn):
     """Dense reference path at (H_ref, N_ref) and its zoomed peak.
 
-    A path that stops before the peak (the stick-slip law's continuation is fragile at small
-    steps) is retried with larger steps (``ds_max`` 2.5x, 6.25x ...; the default last)."""
+    A path that stops before the end of the range (the stick-slip law's continuation is
+    fragile) is retried with larger steps (``ds_max`` 2.5x, 6.25x, the default); the path
+    that reaches furthest and covers its peak is kept."""
     c = _unlimited(make(*ref_hn))
     name = list(c.analysis.outputs)[0]
+    best = None
     for ds in (REF_DS, 2.5 * REF_DS, 6.25 * REF_DS, None):
         opts = ArclengthOptions(ds_max=ds, max_steps=50000)
         t, ref = cpu(lambda: hbm.frf(c, stability=False, options=opts), repeat=1)
-        if covers_peak(ref, name):
+        if covers_peak(ref, name) and (best is None or ref.freq_hz.max() > best[1].freq_hz.max()):
+            best = (t, ref)
+        if ref.ok:
             break
-    else:
+    if best is None:
         raise RuntimeError(f"reference {c.name}: {ref.message}")
+    t, ref = best
     a, f = zoomed_peak(c, name, ref)
     return c, name, ref, a, f, t
 
@@ -291,9 +304,9 @@ def run_case(etype, key, make, opts, quick):
 
 
 def meets(r):
-    """The criterion at one setting: peak error < PEAK_TOL and whole-FRF error < FRF_TOL
-    (a failed run, NaN, does not meet it)."""
-    return bool(r["peak_error"] < PEAK_TOL and r["frf_error"] < FRF_TOL)
+    """The criterion at one setting: the path reached the end of the range, peak error <
+    PEAK_TOL and whole-FRF error < FRF_TOL (NaN, a failed run, does not meet it)."""
+    return bool(r["status"] == "finished" and r["peak_error"] < PEAK_TOL and r["frf_error"] < FRF_TOL)
 
 
 def choose(rows):
@@ -315,7 +328,7 @@ def summarise(all_rows):
     """Per element type: the chosen (H, factor) (max over its cases) against the code's table."""
     print(f"\n== Chosen defaults: smallest H with peak error < {PEAK_TOL:.1%} (the issue's {TARGET:.1%} "
           f"with a safety factor {TARGET / PEAK_TOL:.0f}) and whole-FRF error < {FRF_TOL:.1%}, "
-          f"at that H and every larger one")
+          f"the path finished, at that H and every larger one")
     print(f"  {'element':<20} {'H':>3} {'factor':>6} {'N':>5} {'peak err':>9} {'FRF err':>9}   "
           f"in code (H, factor)")
     out = {}
