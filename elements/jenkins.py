@@ -27,6 +27,8 @@ class Jenkins(Element):
     coord_names = ("u",)
     keys = ("type", "dofs", "kt", "slip_force", "name")
     quantities = ("slip_fraction", "force_amplitude", "dissipation")
+    default_harmonics = 7           # benchmarks/default_harmonics.py
+    default_samples_factor = 2
 
     def __init__(self, gather, kt, slip_force, name="jenkins"):
         super().__init__(gather, np.array([positive("kt", kt), non_negative("slip_force", slip_force)]), name)
