@@ -131,6 +131,8 @@ class Brush(Element):
             "kn", "kt", "e_star", "gamma_n", "gamma_t", "pivot_height", "name")
     max_passes = 1000
     closure_tol = 1e-12
+    default_harmonics = 3           # benchmarks/default_harmonics.py
+    default_samples_factor = 2
 
     def __init__(self, gather, coord_names, kn, kt, mu, normal_preload, radius_x, radius_y, lx, ly,
                  nx, ny, pivot_height=0.0, name="brush"):

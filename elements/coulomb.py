@@ -30,6 +30,8 @@ class CoulombStickSlip(Element):
     coord_names = ("u",)
     keys = ("type", "dofs", "kt", "normal_load", "mu_static", "mu_kinetic", "name")
     quantities = ("slip_fraction", "force_amplitude", "dissipation")
+    default_harmonics = 9           # benchmarks/default_harmonics.py
+    default_samples_factor = 1
 
     def __init__(self, gather, kt, normal_load, mu_static, mu_kinetic, name="coulomb_stick_slip"):
         mu_s = non_negative("mu_static", mu_static)
@@ -72,6 +74,8 @@ class CoulombRegularised(Element):
     coord_names = ("u",)
     keys = ("type", "dofs", "slip_force", "v_r", "law", "name")
     quantities = ("slip_fraction", "force_amplitude", "dissipation")
+    default_harmonics = 9           # benchmarks/default_harmonics.py
+    default_samples_factor = 2
     laws = {"linear": LINEAR, "arctan": ARCTAN}
 
     def __init__(self, gather, slip_force, v_r, law="linear", name="coulomb_regularised"):

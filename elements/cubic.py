@@ -16,6 +16,8 @@ class Cubic(Element):
     needs_mean = False
     coord_names = ("u",)
     keys = ("type", "dofs", "k3", "name")
+    default_harmonics = 3           # benchmarks/default_harmonics.py
+    default_samples_factor = 1
 
     def __init__(self, gather, k3, name="cubic"):
         super().__init__(gather, np.array([finite("k3", k3)]), name)

@@ -64,6 +64,8 @@ class Friction3D(Element):
     closure_tol = 1e-12
     start_rule = START_PRINCIPAL
     closure = CLOSE_NEWTON
+    default_harmonics = 3           # benchmarks/default_harmonics.py
+    default_samples_factor = 2
 
     def __init__(self, gather, kt, kn, mu, normal_preload, name="friction3d"):
         G = np.array(gather, dtype=float, ndmin=2)

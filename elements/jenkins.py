@@ -30,6 +30,8 @@ class Jenkins(Element):
     quantities = ("slip_fraction", "force_amplitude", "dissipation")
     # a displacement maximum is a reversal point: the loop is closed after one pass
     start_rule = START_ARGMAX
+    default_harmonics = 7           # benchmarks/default_harmonics.py
+    default_samples_factor = 2
 
     def __init__(self, gather, kt, slip_force, name="jenkins"):
         super().__init__(gather, np.array([positive("kt", kt), non_negative("slip_force", slip_force)]), name)

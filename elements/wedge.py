@@ -86,6 +86,8 @@ class WedgeDamper(Element):
     velocity = False
     needs_mean = True
     keys = KEYS
+    default_harmonics = 5           # benchmarks/default_harmonics.py
+    default_samples_factor = 1
 
     def __init__(self, params: WedgeParams, platform, damper, n_dof, name="wedge_damper"):
         self.wedge = params

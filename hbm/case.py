@@ -18,6 +18,11 @@ Schema (``../shared/DESIGN.md``)::
     [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], max_points, transform,
                   outputs = {name = dof, name = [a, b], name = "ELEMENT.QUANTITY"}
 
+Without ``harmonics`` / ``time_samples`` a case takes its elements' defaults
+(:func:`element_defaults`): the largest ``default_harmonics`` and ``default_samples_factor``
+over its elements (H = 1, factor 1 for a case without elements: a linear response has the
+first harmonic only), and ``N = factor * default_samples(H)``.  Given values always win.
+
 A DOF is an index or a name (model DOF names, builder names such as ``n3.ux``, point
 coordinates such as ``"blade1.platform.x"``, element DOFs such as ``"upd.x"``).  An output is
 a DOF, ``[a, b]`` for the relative motion ``q_a - q_b``, a weighted combination
@@ -82,6 +87,8 @@ class Analysis:
     ``outputs`` maps output names to gather rows (n,) (``y = g . q``: a DOF, ``q_a - q_b``, a
     point coordinate or a weighted combination); ``element_outputs`` maps output names to
     ``(element index, quantity)`` for the outputs written ``"ELEMENT.QUANTITY"``.
+    ``harmonics_source`` / ``samples_source`` say whether H and N were given in the case
+    (``"case"``) or are the elements' defaults (``"default"``, :func:`element_defaults`).
     """
 
     harmonics: np.ndarray
@@ -91,6 +98,9 @@ class Analysis:
     max_points: int = 2000
     transform: str = "auto"
     element_outputs: dict = field(default_factory=dict)
+    harmonics_source: str = "case"      # "case" (given) or "default" (the elements' default)
+    samples_source: str = "case"
+    samples_factor: int = 1             # the elements' default_samples_factor (for overrides of H)
 
     def output_rows(self, n_dof: int) -> np.ndarray:
         """Output gather rows ``y = G_o q``, shape (n_outputs, n_dof), in the order of ``outputs``."""
@@ -413,13 +423,38 @@ def _element_output(key, value, elements, path):
     return hits[0], qty
 
 
+LINEAR_DEFAULT = (1, 1)     # (H, samples factor) of a case without elements
+
+
+def element_defaults(elements) -> tuple:
+    """Default ``(H, samples factor)`` of a case with these elements.
+
+    The largest ``default_harmonics`` and the largest ``default_samples_factor`` over the
+    elements' classes (:class:`elements.Element`); ``LINEAR_DEFAULT`` = (1, 1) without
+    elements.
+
+    Parameters
+    ----------
+    elements : sequence of Element
+
+    Returns
+    -------
+    (int, int)
+    """
+    if not elements:
+        return LINEAR_DEFAULT
+    return (max(int(type(e).default_harmonics) for e in elements),
+            max(int(type(e).default_samples_factor) for e in elements))
+
+
 def _analysis(t, model, elements, path):
     _check_keys(t, ANALYSIS_KEYS, "[analysis]", path)
     for k in ("frequency_hz", "outputs"):
         if k not in t:
             raise CaseError(f"{path}: [analysis] missing key {k!r}")
     needs_mean = any(e.needs_mean for e in elements)
-    hs = t.get("harmonics", 5)
+    H_default, factor = element_defaults(elements)
+    hs = t.get("harmonics", H_default)
     if isinstance(hs, bool) or not isinstance(hs, (int, list)):
         raise CaseError(f"{path}: [analysis] harmonics must be an integer H or a list of integers, got {hs!r}")
     try:
@@ -428,7 +463,7 @@ def _analysis(t, model, elements, path):
         raise CaseError(f"{path}: [analysis] {exc}") from None
     if 1 not in h:
         raise CaseError(f"{path}: [analysis] harmonics must include 1 (the excitation's harmonic)")
-    N = t.get("time_samples", default_samples(h))
+    N = t.get("time_samples", default_samples(h, factor))
     _number(N, "[analysis] time_samples", path, positive=True, integer=True)
     if N < min_samples(h):
         raise CaseError(f"{path}: [analysis] time_samples={N} too small for harmonics up to {h.max()} "
@@ -460,7 +495,9 @@ def _analysis(t, model, elements, path):
     tr = t.get("transform", "auto")
     if tr not in ("auto", "dft", "numpy", "fftw"):
         raise CaseError(f"{path}: [analysis] transform must be auto, dft, numpy or fftw, got {tr!r}")
-    return Analysis(h, int(N), (float(lo), float(hi)), outputs, int(mp), tr, element_outputs)
+    return Analysis(h, int(N), (float(lo), float(hi)), outputs, int(mp), tr, element_outputs,
+                    "case" if "harmonics" in t else "default", "case" if "time_samples" in t else "default",
+                    factor)
 
 
 def case_from_dict(data: dict, path: str = "<case>", base_dir: Path | None = None) -> Case:

@@ -114,6 +114,12 @@ def _check_outdir(path):
         raise CaseError(f"-o {path}: exists and is not a folder")
 
 
+def _defaults_note(st) -> str:
+    """`` (element defaults: H, N)`` for the settings that were not given, else empty."""
+    d = [k for k, s in (("H", "harmonics_source"), ("N", "time_samples_source")) if st.get(s) == "default"]
+    return f" (element defaults: {', '.join(d)})" if d else ""
+
+
 def cmd_frf(args) -> int:
     from .response import frf
     from .report import write_frf
@@ -126,7 +132,8 @@ def cmd_frf(args) -> int:
         sys.stderr.write("\r" + " " * 40 + "\r")
     summary = write_frf(case, res, args.out)
     print(f"{case.name}: {summary['n_points']} points, {summary['newton_iterations']} Newton iterations, "
-          f"{summary['solve_seconds']:.3f} s, H={res.settings['harmonics'][-1]}, N={res.settings['time_samples']}")
+          f"{summary['solve_seconds']:.3f} s, H={res.settings['harmonics'][-1]}, N={res.settings['time_samples']}"
+          + _defaults_note(res.settings))
     st = res.settings
     if st.get("solver") == "condensed":
         print(f"  condensed solver: {st['n_dof']} DOFs -> {st['contact_coordinates']} contact coordinates, "

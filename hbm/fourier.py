@@ -71,10 +71,14 @@ def min_samples(harmonics) -> int:
     return 2 * int(np.max(harmonics)) + 1
 
 
-def default_samples(harmonics) -> int:
-    """A power of two with at least 8 samples per period of the highest harmonic (>= 64)."""
+def default_samples(harmonics, factor: int = 1) -> int:
+    """``factor`` times a power of two with at least 8 samples per period of the highest
+    harmonic (and at least 64); ``factor`` (an integer >= 1) is the elements'
+    ``default_samples_factor`` (friction laws need more samples than harmonics)."""
+    if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 1:
+        raise ValueError(f"samples factor must be an integer >= 1, got {factor!r}")
     need = 8 * int(np.max(harmonics))
-    return int(max(64, 1 << int(np.ceil(np.log2(max(need, 2))))))
+    return int(factor) * int(max(64, 1 << int(np.ceil(np.log2(max(need, 2))))))
 
 
 @dataclass(frozen=True)

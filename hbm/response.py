@@ -92,7 +92,12 @@ class FRFResult:
 
 
 def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None):
-    """Analysis settings with command-line / API overrides applied and validated."""
+    """Analysis settings with command-line / API overrides applied and validated.
+
+    An override of H without one of N gives ``N = factor * default_samples(H)`` (``factor``
+    the elements' ``default_samples_factor``), or the case's N if that is larger and was
+    given in the case.
+    """
     a = case.analysis
     if harmonics is None:
         h = a.harmonics
@@ -104,7 +109,8 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
         if 1 not in h:
             raise CaseError(f"--harmonics must include 1 (the excitation's harmonic), got {list(map(int, h))}")
     if samples is None:
-        N = a.time_samples if harmonics is None else max(a.time_samples, default_samples(h))
+        N_case = a.time_samples if a.samples_source == "case" else 0
+        N = a.time_samples if harmonics is None else max(N_case, default_samples(h, a.samples_factor))
     else:
         N = int(samples)
     if N < min_samples(h):
@@ -115,6 +121,22 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
         raise CaseError(f"frequency range is empty or not positive ({lo} .. {hi} Hz)")
     tr = transform or a.transform
     return h, N, lo, hi, tr
+
+
+def setting_sources(case: Case, harmonics, samples, N: int) -> dict:
+    """Where H and N came from, for the FRF settings: ``harmonics_source`` and
+    ``time_samples_source``, each ``"argument"`` (API / command-line override), ``"case"``
+    (the case file) or ``"default"`` (the elements' defaults, :func:`hbm.case.element_defaults`).
+    ``N`` is the resolved sample count (:func:`resolve_settings`)."""
+    a = case.analysis
+    if samples is not None:
+        ns = "argument"
+    elif harmonics is None:
+        ns = a.samples_source
+    else:
+        ns = "case" if a.samples_source == "case" and N == a.time_samples else "default"
+    return {"harmonics_source": "argument" if harmonics is not None else a.harmonics_source,
+            "time_samples_source": ns}
 
 
 # Smallest per-DOF unknown scale, relative to the largest.  DOFs that the linear responses
@@ -387,7 +409,8 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     xscale = _unknown_scale(problem, case, w_lo, w_hi)
     r_scale = _residual_scale(problem, w_lo)
     settings = {"harmonics": [int(x) for x in h], "time_samples": int(N), "fmin_hz": lo, "fmax_hz": hi,
-                "transform": problem.nl.transform.name, "stability": stability, **info}
+                "transform": problem.nl.transform.name, "stability": stability,
+                **setting_sources(case, harmonics, samples, N), **info}
     shape = (basis.n_coef, problem.n_dof)
     pts = _Path()
     status, message, folds, n_rej = "failed", "", [], 0
