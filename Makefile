@@ -18,8 +18,10 @@ setup: $(STAMP)
 run: $(STAMP)
 	$(BIN)/hbm frf $(CASE) -o out
 
+# one BLAS thread: the tests' matrices are small, and a threaded BLAS on busy cores slows
+# them by an order of magnitude
 test: $(STAMP)
-	$(BIN)/python -m pytest tests
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest tests
 
 # the full stress matrix (minutes; STRESS_JOBS=n worker processes, default: all cores)
 stress: $(STAMP)

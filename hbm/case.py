@@ -39,7 +39,6 @@ import copy
 import math
 import tomllib
 import zipfile
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 

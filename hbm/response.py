@@ -146,13 +146,6 @@ def setting_sources(case: Case, harmonics, samples, N: int) -> dict:
 SCALE_FLOOR = 1e-2
 
 
-# Smallest per-DOF unknown scale, relative to the largest.  DOFs that the linear responses
-# leave at rest (by symmetry, e.g. the radial motion of a wedge damper in the in-phase mode)
-# still move through nonlinear effects (mean shifts from normal-load variation); with a floor
-# of 1e-6 the continuation measured those small motions as huge scaled steps and stalled.
-SCALE_FLOOR = 1e-2
-
-
 def choose_solver(case: Case) -> str:
     """``full`` or ``condensed`` for ``case`` (``[model] solver``, ``auto`` by size)."""
     s = case.reduction.solver
