@@ -103,10 +103,9 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
         if state_closed and (seeds_closed or seeds_fixed):
             closed = True
             break
-        K = eye - Ms
-        singular = np.linalg.cond(K) > 1e12
         if state_closed:
-            if singular:
+            K = eye - Ms
+            if np.linalg.cond(K) > 1e12:
                 closed = True
                 break
             # periodic state, non-periodic seeds: solve the affine seed map once, then re-record
@@ -117,9 +116,12 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
         if res >= last_res and passes > 2:
             newton_ok = False
         last_res = res
-        if slow and newton_ok and not singular:
-            s[:] = s_begin + np.linalg.solve(K, s - s_begin)
-            ds[:, :] = ds_begin + np.linalg.solve(K, ds - ds_begin)
+        if slow and newton_ok:
+            # the condition number (an SVD) only where the Newton update needs it
+            K = eye - Ms
+            if np.linalg.cond(K) <= 1e12:
+                s[:] = s_begin + np.linalg.solve(K, s - s_begin)
+                ds[:, :] = ds_begin + np.linalg.solve(K, ds - ds_begin)
     if not closed:
         passes = -passes
     return f, df, passes
