@@ -159,7 +159,7 @@ def sphere_constraint(center: np.ndarray, radius: float) -> Constraint:
 
 def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             constraint: Constraint, rho0: float | None, tol: float, max_iter: int, max_backtrack: int,
-            stall_factor: float = 10.0) -> Correction:
+            stall_factor: float = 10.0, stall_window: int = 3) -> Correction:
     """Newton with backtracking on ``[R(s*xs); g(xs)] = 0`` (module doc).
 
     Parameters
@@ -182,6 +182,11 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     stall_factor : float
         Without convergence, the best iterate is accepted if its residual is within
         ``stall_factor * tol`` and it satisfies the constraint (cycling at a kink).
+    stall_window : int
+        Newton gives up early when the last ``stall_window`` iterates have not halved the
+        smallest merit of the iterates before them (at least ``2 stall_window`` iterates
+        seen; 0: never): cycling at a stick-slip kink, which a shorter step resolves
+        sooner than further iterations at this one.
 
     Returns
     -------
@@ -196,6 +201,8 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     rhs = np.empty(n + 1)
     A = np.empty((n + 1, n + 1), order="F")     # refilled before every solve
     best = (np.inf, ev, 0)
+    history = []
+    stalled = False
     for it in range(max_iter + 1):
         rho = max(rho0, ev.row_norm())
         res = ev.r_max / rho
@@ -204,6 +211,11 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         converged = res <= tol and abs(g) <= tol * size
         if res < best[0] and abs(g) <= tol * size:
             best = (res, ev, it)
+        history.append(max(res, abs(g) / size))
+        if not converged and stall_window and len(history) > 2 * stall_window \
+                and min(history[-stall_window:]) > 0.5 * min(history[:-stall_window]):
+            stalled = True      # cycling at a kink: a shorter step will do better
+            break
         if it == max_iter and not converged:
             break
         A[:n] = ev.Js
@@ -250,5 +262,8 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     res = ev.r_max / rho
     if best[0] <= stall_factor * tol:
         return Correction(True, best[1], best[2], best[0])
+    if stalled:
+        return Correction(False, ev, it, res, f"Newton stalled after {it} iterations "
+                          f"(residual {res:.1e}, best {min(history):.1e})")
     return Correction(False, ev, max_iter, res,
                       f"no convergence in {max_iter} iterations (residual {res:.1e})")

@@ -282,3 +282,21 @@ def test_corrector_null_vector_is_the_tangent_system_solution():
     ref = null_tangent(c.ev.Js, t)
     assert np.abs(v - ref).max() < 1e-12
     assert abs(t @ c.null - 1.0) < 1e-12      # normalised by the constraint row
+
+
+def test_corrector_gives_up_early_when_newton_stalls():
+    """A residual that no update reduces (cycling at a kink) fails after 2 * stall_window
+    iterations with the reason stated, instead of spending max_iter iterations on it."""
+    from continuation.corrector import Evaluation, correct, linear_constraint
+    calls = []
+
+    def evaluate(xs):
+        calls.append(xs)
+        return Evaluation(xs.copy(), np.array([1e-3]), np.array([[1.0, 0.0]]))
+    con = linear_constraint(np.array([0.0, 1.0]), 0.0)
+    c = correct(evaluate, np.zeros(2), con, None, 1e-10, 12, 2, stall_window=3)
+    assert not c.converged and "stalled" in c.reason
+    assert len(calls) == 1 + 6 * 3          # 6 iterations of 1 + 2 backtracking calls
+    calls.clear()
+    c = correct(evaluate, np.zeros(2), con, None, 1e-10, 12, 2, stall_window=0)
+    assert not c.converged and "no convergence in 12" in c.reason and len(calls) == 1 + 12 * 3
