@@ -260,10 +260,12 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         ev = trial
     rho = max(rho0, ev.row_norm())
     res = ev.r_max / rho
-    if best[0] <= stall_factor * tol:
-        return Correction(True, best[1], best[2], best[0])
     if stalled:
+        # no acceptance of the best iterate here: a shorter step converges properly
+        # (the best of a few cycling iterates can be off by far more than its residual says)
         return Correction(False, ev, it, res, f"Newton stalled after {it} iterations "
                           f"(residual {res:.1e}, best {min(history):.1e})")
+    if best[0] <= stall_factor * tol:
+        return Correction(True, best[1], best[2], best[0])
     return Correction(False, ev, max_iter, res,
                       f"no convergence in {max_iter} iterations (residual {res:.1e})")

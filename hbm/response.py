@@ -304,6 +304,9 @@ def _residual_scale(problem, w) -> float:
 
 
 POLISH_ENERGY = 1e-10
+# a point whose energy balance stays looser than this after polishing is not a solution
+# the FRF can report: the path ends before it (status failed, the point named)
+ENERGY_LIMIT = 1e-8
 
 
 def _polish(problem, X, w, xscale, r_scale, err):
@@ -339,7 +342,8 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     """One continuation from ``(X0, w0)`` in ``direction``; appends to ``pts``.
 
     Returns ``(status, message, folds_hz, n_rejected)``.  Points whose energy balance is
-    looser than ``POLISH_ENERGY`` are polished by a fixed-frequency Newton solve.
+    looser than ``POLISH_ENERGY`` are polished by a fixed-frequency Newton solve; a point
+    still looser than ``ENERGY_LIMIT`` ends the path (status ``failed``, not kept).
     """
     scale = np.r_[xscale, bounds[1] - bounds[0]]
     solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
@@ -350,6 +354,11 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
         err = energy_balance(problem, X, w).relative_error
         if err > POLISH_ENERGY:
             X, err = _polish(problem, X, w, xscale, r_scale, err)
+        if err > ENERGY_LIMIT:
+            return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
+                    f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "
+                    f"after polishing); the {len(pts.w)} points before it are kept",
+                    [f / (2 * np.pi) for f in solver.folds], solver.n_rejected)
         pts.X.append(X)
         pts.w.append(w)
         pts.Y.append(recover_outputs(problem, case, X, w))
