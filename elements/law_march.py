@@ -41,7 +41,7 @@ CLOSE_NEWTON = 1
 
 @nb.njit(cache=True)
 def principal_reversal_index(u, n):
-    """Reversal sample of the first ``n`` (1 or 2; more: LAPACK) columns of ``u`` (N, >= n)."""
+    """Reversal sample of the first ``n`` (1 or 2) columns of ``u`` (N, >= n)."""
     N = u.shape[0]
     if n == 1:
         return int(np.argmax(u[:, 0]))
@@ -72,13 +72,8 @@ def principal_reversal_index(u, n):
         if v[0] == 0.0 and v[1] == 0.0:
             v[0] = 1.0
     else:
-        C = np.zeros((n, n))
-        for j in range(N):
-            for a in range(n):
-                for b in range(n):
-                    C[a, b] += (u[j, a] - mean[a]) * (u[j, b] - mean[b])
-        _, vecs = np.linalg.eigh(C)
-        v[:] = vecs[:, n - 1]
+        # tangential motions have at most two components; no LAPACK eigensolver compiled in
+        raise ValueError("principal reversal needs 1 or 2 columns")
     big = 0
     for a in range(n):
         if abs(v[a]) > abs(v[big]):

@@ -17,14 +17,14 @@ and the Jacobian follows from the same march with forward-mode seeds
 
 assembled by batched products with the small dense ``G`` (never as a Kronecker product).
 Only the DOFs touched by an element (the nonlinear DOFs) enter the AFT.  Law elements on the
-DFT-matrix transform take the fused numba path of :mod:`hbm.aft_kernel` (same numbers, one
-call per law, linear periods without a march).
+DFT-matrix transform take the compiled path of :mod:`hbm.aft_kernel` (same numbers, three
+numba calls per law, linear periods without a march).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .aft_kernel import aft_law, aft_law_forces
+from .aft_kernel import aft_law
 from .fourier import FourierBasis
 
 
@@ -70,11 +70,11 @@ class NonlinearForces:
         self._G = [np.ascontiguousarray(e.gather[:, self.dofs]) for e in self.elements]
         self._seed_u = {}
         self._seed_v = {}
-        # fused path: (G rows of the law, LawSpec) per law part, or None for a generic element
-        fused = getattr(transform, "name", "") == "dft"
+        # compiled path: (G rows of the law, LawSpec) per law part, or None for a generic element
+        compiled = getattr(transform, "name", "") == "dft"
         self._parts = []
         for e, G in zip(self.elements, self._G):
-            parts = e.law_parts() if fused else None
+            parts = e.law_parts() if compiled else None
             self._parts.append(None if parts is None else
                                [(np.ascontiguousarray(G[rows]), spec) for rows, spec in parts])
         rows0 = np.flatnonzero(basis.h_of_row == 0)
@@ -130,9 +130,7 @@ class NonlinearForces:
         for e, G, parts in zip(self.elements, self._G, self._parts):
             if parts is not None:
                 for Gp, sp in parts:
-                    aft_law(sp.kind, sp.params, sp.n_state, sp.closure, sp.start_rule, sp.n_start,
-                            sp.velocity, sp.max_passes, sp.tol, Gp, Xnl, w, self._E, self._dE,
-                            self._P, self._row0, F, J4, dFdw)
+                    aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw)
                 continue
             nl = e.n_local
             U = Xnl @ G.T
@@ -165,9 +163,7 @@ class NonlinearForces:
         for i, parts in enumerate(self._parts):
             if parts is not None:
                 for Gp, sp in parts:
-                    aft_law_forces(sp.kind, sp.params, sp.n_state, sp.closure, sp.start_rule,
-                                   sp.n_start, sp.velocity, sp.max_passes, sp.tol, Gp, Xnl, w,
-                                   self._E, self._dE, self._P, self._row0, F)
+                    aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F)
                 continue
             z = self.element_samples(Xnl, w, i)
             f, _ = self.elements[i].march(z, np.zeros(z.shape + (1,)))

@@ -1,4 +1,4 @@
-r"""Fused AFT of one law on DFT matrices: synthesis, seeded march, analysis and gather in one call.
+r"""AFT of one law on DFT matrices in three compiled steps: inputs, march, analysis + gather.
 
 For a law acting on local coordinates ``u = G q`` (``G`` (n_l, n_nl) on the nonlinear DOFs)
 with coefficients ``U = X G^T`` (n_coef, n_l):
@@ -18,19 +18,51 @@ follow without marching or transforming, ``P f = K U + f_0 e_0`` (``e_0`` the me
 
 This is the path :class:`hbm.aft.NonlinearForces` takes for law elements when the
 transform is the DFT matrix (few harmonics); it returns the same numbers as the generic path
-(element ``march`` between transform calls), to round-off.
+(element ``march`` between transform calls), to round-off.  The three steps are separate
+compiled functions on purpose: one function calling the march would make numba link and
+re-optimise every law kernel and both closures into it, which multiplied the first run's
+compile time (measured: 16 s -> 59 s CPU for the default rig).
 """
 from __future__ import annotations
 
 import numba as nb
 import numpy as np
 
-from elements.law_march import start_sample, linear_shortcut, march_law
+from elements.closure import march_newton
+from elements.kernels import march
+from elements.law_march import CLOSE_NEWTON, linear_shortcut, start_sample
 
 
 @nb.njit(cache=True)
-def _coordinates(G, X, w, E, dE, velocity):
-    """``U = X G^T`` (n_coef, n_l), inputs ``z`` (N, n_z) and ``E' U`` (N, n_l)."""
+def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
+    """Coordinates, march inputs and seeds of one law, or its linear shortcut.
+
+    Parameters
+    ----------
+    kind, p, start_rule, n_start, velocity
+        The law (:class:`elements.base.LawSpec`).
+    seeds : bool
+        Seed the march with ``dz/dU`` (and ``dz/dw``); False: one zero seed (forces only).
+    G : ndarray, shape (n_l, n_nl)
+    X : ndarray, shape (n_coef, n_nl)
+        Coefficients of the nonlinear DOFs.
+    w : float
+    E, dE : ndarray, shape (N, n_coef)
+        Synthesis matrix and its derivative in the phase.
+
+    Returns
+    -------
+    U : ndarray, shape (n_coef, n_l)
+    z : ndarray, shape (N, n_z)
+    dz : ndarray, shape (N, n_z, P)
+        ``P = n_coef n_l + 1`` with seeds, else 1 (zero).
+    start : int
+        Start sample of the march.
+    linear : bool
+        The law is linear over the period: ``f = f0 + K z`` (then ``dz`` is not filled).
+    K : ndarray, shape (n_l, n_z)
+    f0 : ndarray, shape (n_l,)
+    """
     nc, nn = X.shape
     nl = G.shape[0]
     N = E.shape[0]
@@ -42,108 +74,28 @@ def _coordinates(G, X, w, E, dE, velocity):
                 for k in range(nc):
                     U[k, a] += X[k, i] * g
     nz = 2 * nl if velocity else nl
-    z = np.empty((N, nz))
-    z[:, :nl] = E @ U
+    z = np.zeros((N, nz))
     dth = np.zeros((N, nl))
+    for j in range(N):          # synthesis by loops: small, and no BLAS binding to compile
+        for k in range(nc):
+            e = E[j, k]
+            de = dE[j, k]
+            for a in range(nl):
+                z[j, a] += e * U[k, a]
+                if velocity:
+                    dth[j, a] += de * U[k, a]
     if velocity:
-        dth[:, :] = dE @ U
-        z[:, nl:] = w * dth
-    return U, z, dth
-
-
-@nb.njit(cache=True)
-def _gather_forces(G, Fe, F):
-    """``F += Fe G``: (n_coef, n_l) local coefficients onto the nonlinear DOFs (n_coef, n_nl)."""
-    nl, nn = G.shape
-    for a in range(nl):
-        for i in range(nn):
-            g = G[a, i]
-            if g != 0.0:
-                for k in range(Fe.shape[0]):
-                    F[k, i] += Fe[k, a] * g
-
-
-@nb.njit(cache=True)
-def aft_law_forces(kind, p, n_state, closure, start_rule, n_start, velocity, max_passes, tol,
-                   G, X, w, E, dE, P, row0, F):
-    """Forces only: ``F += (P f) G`` (arguments as :func:`aft_law`), no derivative seeds."""
-    nl = G.shape[0]
-    N = E.shape[0]
-    U, z, dth = _coordinates(G, X, w, E, dE, velocity)
-    nz = z.shape[1]
+        for j in range(N):
+            for a in range(nl):
+                z[j, nl + a] = w * dth[j, a]
     K = np.zeros((nl, nz))
     f0 = np.zeros(nl)
-    passes = 0
-    if (not velocity) and linear_shortcut(kind, p, z, K, f0):
-        Fe = np.zeros((U.shape[0], nl))
-        for a in range(nl):
-            for b in range(nl):
-                if K[a, b] != 0.0:
-                    for k in range(U.shape[0]):
-                        Fe[k, a] += K[a, b] * U[k, b]
-            if row0 >= 0:
-                Fe[row0, a] += f0[a]
-    else:
-        dz = np.zeros((N, nz, 1))
-        start = start_sample(start_rule, n_start, z)
-        f, _, passes = march_law(kind, p, n_state, nl, closure, start, z, dz, max_passes, tol)
-        Fe = P @ f
-    _gather_forces(G, Fe, F)
-    return passes
-
-
-@nb.njit(cache=True)
-def aft_law(kind, p, n_state, closure, start_rule, n_start, velocity, max_passes, tol,
-            G, X, w, E, dE, P, row0, F, J4, dFdw):
-    """Add one law's harmonic forces and exact derivatives (module doc).
-
-    Parameters
-    ----------
-    kind, p, n_state, closure, start_rule, n_start, velocity, max_passes, tol
-        The law (:class:`elements.base.LawSpec`).
-    G : ndarray, shape (n_l, n_nl)
-    X : ndarray, shape (n_coef, n_nl)
-        Coefficients of the nonlinear DOFs.
-    w : float
-    E, dE : ndarray, shape (N, n_coef)
-        Synthesis matrix and its derivative in the phase.
-    P : ndarray, shape (n_coef, N)
-        Analysis matrix.
-    row0 : int
-        Row of the mean (harmonic 0) in the coefficients, -1 if absent.
-    F, dFdw : ndarray, shape (n_coef, n_nl)
-        Accumulated in place.
-    J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl)
-        Accumulated in place.
-
-    Returns
-    -------
-    passes : int
-        Periods marched (0: linear shortcut; negative: the loop did not close).
-    """
-    nc, nn = X.shape
-    nl = G.shape[0]
-    N = E.shape[0]
-    U, z, dth = _coordinates(G, X, w, E, dE, velocity)
-    nz = z.shape[1]
-    Fe = np.zeros((nc, nl))
-    K = np.zeros((nl, nz))
-    f0 = np.zeros(nl)
-    Pc = nc * nl + 1
-    dFe = np.zeros((nc, nl, Pc))
-    passes = 0
-    if (not velocity) and linear_shortcut(kind, p, z, K, f0):
-        for a in range(nl):
-            for b in range(nl):
-                kab = K[a, b]
-                if kab != 0.0:
-                    for k in range(nc):
-                        Fe[k, a] += kab * U[k, b]
-                        dFe[k, a, k * nl + b] = kab
-            if row0 >= 0:
-                Fe[row0, a] += f0[a]
-    else:
-        dz = np.zeros((N, nz, Pc))
+    Pc = nc * nl + 1 if seeds else 1
+    linear = (not velocity) and linear_shortcut(kind, p, z, K, f0)
+    if linear:
+        return U, z, np.zeros((0, nz, Pc)), 0, True, K, f0
+    dz = np.zeros((N, nz, Pc))
+    if seeds:
         for j in range(N):
             for a in range(nl):
                 for m in range(nc):
@@ -153,13 +105,26 @@ def aft_law(kind, p, n_state, closure, start_rule, n_start, velocity, max_passes
                     for m in range(nc):
                         dz[j, nl + a, m * nl + a] = w * dE[j, m]
                     dz[j, nl + a, Pc - 1] = dth[j, a]
-        start = start_sample(start_rule, n_start, z)
-        f, df, passes = march_law(kind, p, n_state, nl, closure, start, z, dz, max_passes, tol)
-        Fe[:, :] = P @ f
-        dFe[:, :, :] = (P @ df.reshape(N, nl * Pc)).reshape(nc, nl, Pc)
-    # gather: F += Fe G, dFdw += dFe[..., -1] G, J4 += G^T dFe G per harmonic pair
-    _gather_forces(G, Fe, F)
-    _gather_forces(G, np.ascontiguousarray(dFe[:, :, Pc - 1]), dFdw)
+    return U, z, dz, start_sample(start_rule, n_start, z), False, K, f0
+
+
+@nb.njit(cache=True)
+def _gather(G, Fe, dFe, F, J4, dFdw, seeds):
+    """``F += Fe G``; with seeds also ``dFdw += dFe[..., -1] G`` and
+    ``J4[k, :, m, :] += G^T dFe[k, :, m-block] G`` (loops skip the zeros of ``G``)."""
+    nc = Fe.shape[0]
+    nl, nn = G.shape
+    for a in range(nl):
+        for i in range(nn):
+            g = G[a, i]
+            if g == 0.0:
+                continue
+            for k in range(nc):
+                F[k, i] += Fe[k, a] * g
+                if seeds:
+                    dFdw[k, i] += dFe[k, a, dFe.shape[2] - 1] * g
+    if not seeds:
+        return
     for k in range(nc):
         for a in range(nl):
             for m in range(nc):
@@ -175,4 +140,94 @@ def aft_law(kind, p, n_state, closure, start_rule, n_start, velocity, max_passes
                             gb = G[b, j]
                             if gb != 0.0:
                                 J4[k, i, m, j] += ga * d * gb
+
+
+@nb.njit(cache=True)
+def aft_analyse(P, f, df, G, F, J4, dFdw, seeds):
+    """Analysis ``P f``, ``P df`` of a marched period and the gather onto the nonlinear DOFs.
+
+    Parameters
+    ----------
+    P : ndarray, shape (n_coef, N)
+    f : ndarray, shape (N, n_l)
+    df : ndarray, shape (N, n_l, P_s)
+    G : ndarray, shape (n_l, n_nl)
+    F, dFdw : ndarray, shape (n_coef, n_nl)
+        Accumulated in place (``dFdw`` only with seeds).
+    J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl)
+        Accumulated in place (only with seeds).
+    seeds : bool
+    """
+    nc, N = P.shape
+    nl = f.shape[1]
+    Fe = P @ f
+    if seeds:
+        Ps = df.shape[2]
+        dFe = (P @ np.ascontiguousarray(df).reshape(N, nl * Ps)).reshape(nc, nl, Ps)
+    else:
+        dFe = np.zeros((nc, nl, 1))
+    _gather(G, Fe, dFe, F, J4, dFdw, seeds)
+
+
+@nb.njit(cache=True)
+def aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds):
+    """Gather of a linear period: ``P f = K U + f0 e_0``, ``d(P f)/dU = K (x) I`` (module doc).
+
+    ``row0`` is the row of the mean (harmonic 0), -1 if absent; other arguments as
+    :func:`aft_analyse`.
+    """
+    nc, nl = U.shape
+    Pc = nc * nl + 1 if seeds else 1
+    Fe = np.zeros((nc, nl))
+    dFe = np.zeros((nc, nl, Pc))
+    for a in range(nl):
+        for b in range(nl):
+            kab = K[a, b]
+            if kab != 0.0:
+                for k in range(nc):
+                    Fe[k, a] += kab * U[k, b]
+                    if seeds:
+                        dFe[k, a, k * nl + b] = kab
+        if row0 >= 0:
+            Fe[row0, a] += f0[a]
+    _gather(G, Fe, dFe, F, J4, dFdw, seeds)
+
+
+def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
+    """Add one law's harmonic forces (and, given ``J4`` and ``dFdw``, exact derivatives).
+
+    Parameters
+    ----------
+    spec : elements.base.LawSpec
+    G : ndarray, shape (n_l, n_nl)
+    X : ndarray, shape (n_coef, n_nl)
+        Coefficients of the nonlinear DOFs (C-contiguous).
+    w : float
+    E, dE : ndarray, shape (N, n_coef)
+    P : ndarray, shape (n_coef, N)
+    row0 : int
+        Row of the mean (harmonic 0), -1 if absent.
+    F : ndarray, shape (n_coef, n_nl)
+    J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl), optional
+    dFdw : ndarray, shape (n_coef, n_nl), optional
+        All accumulated in place.
+
+    Returns
+    -------
+    passes : int
+        Periods marched (0: linear shortcut; negative: the loop did not close).
+    """
+    seeds = J4 is not None
+    if not seeds:
+        J4 = np.zeros((0, 0, 0, 0))
+        dFdw = F
+    U, z, dz, start, linear, K, f0 = aft_inputs(spec.kind, spec.params, spec.start_rule, spec.n_start,
+                                                spec.velocity, seeds, G, X, w, E, dE)
+    if linear:
+        aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
+        return 0
+    run = march_newton if spec.closure == CLOSE_NEWTON else march
+    f, df, passes = run(spec.kind, spec.params, spec.n_state, G.shape[0], z, dz, start,
+                        spec.max_passes, spec.tol)
+    aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
     return passes

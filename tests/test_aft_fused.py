@@ -1,4 +1,4 @@
-"""The fused numba AFT (hbm/aft_kernel.py) against the generic path, its linear shortcut and
+"""The compiled AFT of law elements (hbm/aft_kernel.py) against the generic path, its linear shortcut and
 the closed-form start rule."""
 import numpy as np
 import pytest
@@ -103,8 +103,7 @@ def run_kernel(el, b, X, w=1.0):
     nc, nn = X.shape
     F, J4, dFdw = np.zeros((nc, nn)), np.zeros((nc, nn, nc, nn)), np.zeros((nc, nn))
     row0 = b.row_of(0, "c") if 0 in b.harmonics else -1
-    passes = aft_law(sp.kind, sp.params, sp.n_state, sp.closure, sp.start_rule, sp.n_start, sp.velocity,
-                     sp.max_passes, sp.tol, G, np.ascontiguousarray(X), w, np.ascontiguousarray(b.E),
+    passes = aft_law(sp, G, np.ascontiguousarray(X), w, np.ascontiguousarray(b.E),
                      np.ascontiguousarray(b.dE), np.ascontiguousarray(b.P), row0, F, J4, dFdw)
     return passes, F, J4.reshape(nc * nn, nc * nn)
 
