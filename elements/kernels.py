@@ -30,7 +30,7 @@ from .laws.friction3d import friction3d_step, friction3d_init
 from .laws.coulomb import coulomb_sk_step, coulomb_sk_init, coulomb_reg_step, coulomb_reg_init
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def law_step(kind, p, s, z, s_new, A, B):
     """Dispatch one incremental update to the law ``kind`` (see module docstring)."""
     if kind == JENKINS:
@@ -47,7 +47,7 @@ def law_step(kind, p, s, z, s_new, A, B):
         raise ValueError("unknown law kind")
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def law_init(kind, p, z0, s0, C0):
     """Rest state ``s0`` at input ``z0`` reached from ``q = 0``, and ``C0 = ds0/dz0``."""
     if kind == JENKINS:
@@ -64,7 +64,7 @@ def law_init(kind, p, z0, s0, C0):
         raise ValueError("unknown law kind")
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _accumulate(M, X, out):
     """``out += M @ X`` skipping zero entries of the small matrix ``M``."""
     for i in range(M.shape[0]):
@@ -75,7 +75,7 @@ def _accumulate(M, X, out):
                     out[i, c] += m * X[k, c]
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _propagate(A, B, ds, dz, j, out):
     """``out = A @ ds + B @ dz[j]`` skipping zero entries of the small matrices ``A``, ``B``
     (``dz`` indexed in place: no per-sample view)."""

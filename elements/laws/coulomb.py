@@ -38,7 +38,7 @@ LINEAR = 0
 ARCTAN = 1
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def coulomb_sk_step(p, s, z, s_new, A, B):
     """One stick/slide step; ``A`` (3, 3), ``B`` (3, 1)."""
     kt = p[0]
@@ -66,7 +66,7 @@ def coulomb_sk_step(p, s, z, s_new, A, B):
     B[1, 0] = 1.0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def coulomb_sk_init(p, z0, s0, C0):
     """Rest state at ``z0`` reached from ``q = 0`` monotonically: stuck at ``kt u0`` unless that
     exceeds ``mu_s N``, in which case the contact broke loose and slides at ``mu_k N``."""
@@ -86,7 +86,7 @@ def coulomb_sk_init(p, z0, s0, C0):
     C0[1, 0] = 1.0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _regularised(p, v):
     """Force and its derivative with respect to the velocity."""
     F0 = p[0]
@@ -101,7 +101,7 @@ def _regularised(p, v):
     return F0 * x, F0 / vr
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def coulomb_reg_step(p, s, z, s_new, A, B):
     """``f = Ft0 g(v / v_r)``; ``A`` (1, 1) = 0, ``B`` (1, 2) = [0, df/dv]."""
     f, dfdv = _regularised(p, z[1])
@@ -111,7 +111,7 @@ def coulomb_reg_step(p, s, z, s_new, A, B):
     B[0, 1] = dfdv
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def coulomb_reg_init(p, z0, s0, C0):
     f, dfdv = _regularised(p, z0[1])
     s0[0] = f

@@ -40,7 +40,7 @@ import math
 import numba as nb
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _radial_return(limit, t0, t1):
     """Return mapping of the trial force ``(t0, t1)`` (``t1 = 0`` for one direction) onto the
     circle of radius ``limit``: ``(f0, f1, r, d0, d1, slipping)`` with ``d = f^{tr}/|f^{tr}|``
@@ -55,7 +55,7 @@ def _radial_return(limit, t0, t1):
     return limit * d0, limit * d1, r, d0, d1, True
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, with_A):
     """Tangential forces into ``s_new`` and their derivatives (module doc) into ``A``
     (if ``with_A``: ``df_t/df_prev = J``, ``df_t/du_prev = -kt J``) and ``B``
@@ -78,7 +78,7 @@ def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A,
         B[a, nt] = mu * kn * da if slipping else 0.0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def friction3d_step(p, s, z, s_new, A, B):
     """One return-mapping step; ``A = ds_new/ds`` (ns, ns), ``B = ds_new/dz`` (ns, nt + 1)."""
     kt = p[0]
@@ -108,7 +108,7 @@ def friction3d_step(p, s, z, s_new, A, B):
     _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, True)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def friction3d_init(p, z0, s0, C0):
     """Rest state reached at ``z0`` from ``q = 0`` without reversal, ``C0 = ds0/dz0``.
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numba as nb
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def jenkins_step(p, s, z, s_new, A, B):
     """One return-mapping step; writes ``s_new``, ``A = ds_new/ds`` (2, 2), ``B = ds_new/dz`` (2, 1)."""
     kt = p[0]
@@ -38,7 +38,7 @@ def jenkins_step(p, s, z, s_new, A, B):
     B[1, 0] = 1.0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def jenkins_init(p, z0, s0, C0):
     """Rest state reached at ``z0`` from ``q = 0``; ``C0 = ds0/dz0`` (2, 1)."""
     kt = p[0]
