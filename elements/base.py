@@ -15,7 +15,7 @@ import numpy as np
 
 @dataclass(frozen=True)
 class LawSpec:
-    """What :func:`elements.law_march.march_law` needs to march one law (see that module).
+    """What the march of one law needs (:mod:`elements.law_march`, :mod:`elements.kernels`).
 
     Attributes
     ----------
@@ -140,11 +140,12 @@ class Element:
         f : ndarray, shape (N, n_local)
         df : ndarray, shape (N, n_local, P)
         """
-        from .law_march import march_law
-        f, df, passes = march_law(self.kind, self.params, self.n_state, self.n_local, self.closure,
-                                  self.start_index(z[:, :self.n_local]),
-                                  np.ascontiguousarray(z, dtype=float), np.ascontiguousarray(dz, dtype=float),
-                                  self.max_passes, self.closure_tol)
+        from .law_march import march_for
+        f, df, passes = march_for(self.closure)(self.kind, self.params, self.n_state, self.n_local,
+                                                np.ascontiguousarray(z, dtype=float),
+                                                np.ascontiguousarray(dz, dtype=float),
+                                                self.start_index(z[:, :self.n_local]),
+                                                self.max_passes, self.closure_tol)
         return f, df
 
     def linear_stiffness(self) -> np.ndarray:

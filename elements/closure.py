@@ -25,8 +25,8 @@ Rules (so that the physical transient from the rest state is kept where it decid
   the transverse force of a contact slipping along a line: the state is exactly periodic
   after one pass, its derivative is not), one Newton update of the seeds alone and a last
   pass give the derivative of the periodic solution rather than of a finite number of passes;
-- when ``I - M`` is singular (cond > 1e12: a direction that never slips keeps its start
-  value, the rest-state convention) or a Newton step does not reduce the residual, plain
+- when ``I - M`` is singular (1-norm condition number > 1e12: a direction that never slips
+  keeps its start value, the rest-state convention) or a Newton step does not reduce the residual, plain
   passes are used.
 
 The forces of the last pass, which starts from the closed state, are returned.
@@ -37,6 +37,56 @@ import numba as nb
 import numpy as np
 
 from .kernels import law_step, law_init, _accumulate, _propagate
+
+
+@nb.njit(cache=True)
+def _solve_small(K, R):
+    """Solve ``K Y = R`` (K (n, n), R (n, m)) by Gauss-Jordan elimination with partial pivoting,
+    and the 1-norm condition number ``||K||_1 ||K^{-1}||_1`` (inf if ``K`` is singular).
+
+    The closure's systems have the state size (n <= 5): hand-written elimination instead of
+    LAPACK, whose numba bindings (cond, solve) cost ~12 s of compile time.
+    """
+    n = K.shape[0]
+    m = R.shape[1]
+    W = np.zeros((n, n + m + n))
+    for i in range(n):
+        for j in range(n):
+            W[i, j] = K[i, j]
+        for j in range(m):
+            W[i, n + j] = R[i, j]
+        W[i, n + m + i] = 1.0
+    for c in range(n):
+        piv = c
+        for r in range(c + 1, n):
+            if abs(W[r, c]) > abs(W[piv, c]):
+                piv = r
+        if W[piv, c] == 0.0:
+            return np.zeros((n, m)), np.inf
+        if piv != c:
+            for j in range(W.shape[1]):
+                t = W[c, j]
+                W[c, j] = W[piv, j]
+                W[piv, j] = t
+        d = 1.0 / W[c, c]
+        for j in range(W.shape[1]):
+            W[c, j] *= d
+        for r in range(n):
+            if r != c and W[r, c] != 0.0:
+                f = W[r, c]
+                for j in range(W.shape[1]):
+                    W[r, j] -= f * W[c, j]
+    norm_k = 0.0
+    norm_inv = 0.0
+    for j in range(n):
+        ck = 0.0
+        ci = 0.0
+        for i in range(n):
+            ck += abs(K[i, j])
+            ci += abs(W[i, n + m + j])
+        norm_k = max(norm_k, ck)
+        norm_inv = max(norm_inv, ci)
+    return W[:, n:n + m].copy(), norm_k * norm_inv
 
 
 @nb.njit(cache=True)
@@ -104,12 +154,12 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
             closed = True
             break
         if state_closed:
-            K = eye - Ms
-            if np.linalg.cond(K) > 1e12:
+            Y, cond = _solve_small(eye - Ms, ds - ds_begin)
+            if cond > 1e12:
                 closed = True
                 break
             # periodic state, non-periodic seeds: solve the affine seed map once, then re-record
-            ds[:, :] = ds_begin + np.linalg.solve(K, ds - ds_begin)
+            ds[:, :] = ds_begin + Y
             seeds_fixed = True
             continue
         slow = passes >= 2 and res > 0.3 * last_res
@@ -117,11 +167,14 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
             newton_ok = False
         last_res = res
         if slow and newton_ok:
-            # the condition number (an SVD) only where the Newton update needs it
-            K = eye - Ms
-            if np.linalg.cond(K) <= 1e12:
-                s[:] = s_begin + np.linalg.solve(K, s - s_begin)
-                ds[:, :] = ds_begin + np.linalg.solve(K, ds - ds_begin)
+            # state and seeds updated by one elimination: R = [s - s_begin, ds - ds_begin]
+            Rhs = np.empty((ns, P + 1))
+            Rhs[:, 0] = s - s_begin
+            Rhs[:, 1:] = ds - ds_begin
+            Y, cond = _solve_small(eye - Ms, Rhs)
+            if cond <= 1e12:
+                s[:] = s_begin + Y[:, 0]
+                ds[:, :] = ds_begin + Y[:, 1:]
     if not closed:
         passes = -passes
     return f, df, passes

@@ -151,9 +151,8 @@ def linear_shortcut(kind, p, z, K, f0):
     return False
 
 
-@nb.njit(cache=True)
-def march_law(kind, p, n_state, n_local, closure, start, z, dz, max_passes, tol):
-    """:func:`elements.kernels.march` or :func:`elements.closure.march_newton` by ``closure``."""
-    if closure == CLOSE_NEWTON:
-        return march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol)
-    return march(kind, p, n_state, n_local, z, dz, start, max_passes, tol)
+def march_for(closure):
+    """:func:`elements.kernels.march` or :func:`elements.closure.march_newton` by ``closure``
+    (chosen here, in Python: one compiled function calling both would make numba compile and
+    link both closures for every law)."""
+    return march_newton if closure == CLOSE_NEWTON else march

@@ -1,4 +1,4 @@
-r"""AFT of one law on DFT matrices in three compiled steps: inputs, march, analysis + gather.
+r"""AFT of one law on DFT matrices: inputs, march, analysis + gather, compiled per closure.
 
 For a law acting on local coordinates ``u = G q`` (``G`` (n_l, n_nl) on the nonlinear DOFs)
 with coefficients ``U = X G^T`` (n_coef, n_l):
@@ -18,10 +18,11 @@ follow without marching or transforming, ``P f = K U + f_0 e_0`` (``e_0`` the me
 
 This is the path :class:`hbm.aft.NonlinearForces` takes for law elements when the
 transform is the DFT matrix (few harmonics); it returns the same numbers as the generic path
-(element ``march`` between transform calls), to round-off.  The three steps are separate
-compiled functions on purpose: one function calling the march would make numba link and
-re-optimise every law kernel and both closures into it, which multiplied the first run's
-compile time (measured: 16 s -> 59 s CPU for the default rig).
+(element ``march`` between transform calls), to round-off.  One compiled function per closure
+(:func:`aft_plain`, :func:`aft_newton`), each calling only its own march: a single function
+dispatching to both closures made numba link and re-optimise both (with their LAPACK calls)
+into it, which multiplied the first run's compile time (measured: 16 s -> 59 s CPU for the
+default rig; now about 22 s).  The steps avoid BLAS/LAPACK bindings where loops do.
 """
 from __future__ import annotations
 
@@ -193,6 +194,34 @@ def aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds):
     _gather(G, Fe, dFe, F, J4, dFdw, seeds)
 
 
+@nb.njit(cache=True)
+def aft_plain(kind, p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
+              G, X, w, E, dE, P, row0, F, J4, dFdw):
+    """The three steps in one call for laws closed by plain passes (:func:`aft_law`)."""
+    U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
+                                                G, X, w, E, dE)
+    if linear:
+        aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
+        return 0
+    f, df, passes = march(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
+    aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
+    return passes
+
+
+@nb.njit(cache=True)
+def aft_newton(kind, p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
+               G, X, w, E, dE, P, row0, F, J4, dFdw):
+    """The three steps in one call for laws closed by Newton (:func:`aft_law`)."""
+    U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
+                                                G, X, w, E, dE)
+    if linear:
+        aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
+        return 0
+    f, df, passes = march_newton(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
+    aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
+    return passes
+
+
 def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
     """Add one law's harmonic forces (and, given ``J4`` and ``dFdw``, exact derivatives).
 
@@ -221,13 +250,6 @@ def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
     if not seeds:
         J4 = np.zeros((0, 0, 0, 0))
         dFdw = F
-    U, z, dz, start, linear, K, f0 = aft_inputs(spec.kind, spec.params, spec.start_rule, spec.n_start,
-                                                spec.velocity, seeds, G, X, w, E, dE)
-    if linear:
-        aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
-        return 0
-    run = march_newton if spec.closure == CLOSE_NEWTON else march
-    f, df, passes = run(spec.kind, spec.params, spec.n_state, G.shape[0], z, dz, start,
-                        spec.max_passes, spec.tol)
-    aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
-    return passes
+    run = aft_newton if spec.closure == CLOSE_NEWTON else aft_plain
+    return run(spec.kind, spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity,
+               spec.max_passes, spec.tol, seeds, G, X, w, E, dE, P, row0, F, J4, dFdw)

@@ -158,3 +158,15 @@ def test_principal_reversal_closed_form_matches_eigenvector(rng):
         # of the eigenvector is positive
         s = np.sign(v[np.argmax(np.abs(v))])
         assert np.isclose(s * proj[j0], (s * proj).max(), rtol=1e-12, atol=0)
+
+
+def test_closure_elimination_matches_lapack(rng):
+    from elements.closure import _solve_small
+    for n in (1, 3, 5):
+        K = rng.standard_normal((n, n)) + n * np.eye(n)
+        R = rng.standard_normal((n, 4))
+        Y, cond = _solve_small(K, R)
+        assert np.abs(Y - np.linalg.solve(K, R)).max() < 1e-12 * np.abs(Y).max()
+        assert np.isclose(cond, np.linalg.cond(K, 1), rtol=1e-12)
+    K = np.array([[1.0, 2.0], [2.0, 4.0]])          # singular: infinite condition number
+    assert _solve_small(K, np.ones((2, 1)))[1] == np.inf
