@@ -243,13 +243,17 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             return Correction(True, ev, it, res)
         merit = max(res, abs(g))
         theta = 1.0
+        # near the solution (merit below sqrt(tol)) a full step is taken whatever it gives:
+        # there the merit grows only when a stick-slip switch moves between samples, which a
+        # shorter step does not cure (it would cost up to max_backtrack more evaluations)
+        backtrack_below = max(1e3 * tol, np.sqrt(tol))
         for _ in range(max_backtrack + 1):
             trial = evaluate(ev.xs + theta * delta)
             if trial.finite:
                 rho_t = max(rho0, trial.row_norm())
                 merit_t = max(trial.r_max / rho_t,
                               abs(constraint(trial.xs)[0]))
-                if merit_t < merit or merit <= 1e3 * tol:
+                if merit_t < merit or merit <= backtrack_below:
                     break
             theta *= 0.5
         else:
