@@ -318,6 +318,13 @@ def profile_groups(fun):
     return {k: v / total for k, v in out.items()}
 
 
+def print_profile(case):
+    """Print :func:`profile_groups` of the FRF of ``case`` (without stability)."""
+    print("  where the FRF's time goes (cProfile self time, without stability):")
+    for k, v in profile_groups(lambda: hbm.frf(case, stability=False)).items():
+        print(f"    {k:<50} {100 * v:5.1f} %")
+
+
 def section_target():
     print("\n== 4. Target case: 3-DOF, two Jenkins, H = 7, N = 256")
     c = target_case()
@@ -357,9 +364,7 @@ def section_target():
     print(f"  one Newton iteration (residual + exact Jacobian): {t_call * 1e6:.0f} us; its transforms "
           f"{t_tr * 1e6:.0f} us, its bordered linear solve {t_lin * 1e6:.0f} us: "
           f"ratio {t_call / (t_tr + t_lin):.1f}x (transforms + solve)")
-    print("  where the FRF's time goes (cProfile self time, without stability):")
-    for k, v in profile_groups(lambda: hbm.frf(c, stability=False)).items():
-        print(f"    {k:<50} {100 * v:5.1f} %")
+    print_profile(c)
     return dict(points=res.freq_hz.size, seconds=t, points_300=r300.freq_hz.size, seconds_300=t300,
                 iteration_us=t_call * 1e6, transforms_us=t_tr * 1e6, solve_us=t_lin * 1e6)
 
@@ -381,9 +386,7 @@ def section_upd_like():
     t300, r300 = cpu(lambda: hbm.frf(c, stability=False, options=opts), repeat=3)
     print(f"  FRF (ds_max = 1/130): {r300.freq_hz.size} points, {r300.iterations.sum()} Newton iterations, "
           f"{t300:.3f} s CPU (target: about 300 points in 0.3 s)")
-    print("  where the FRF's time goes (cProfile self time, without stability):")
-    for k, v in profile_groups(lambda: hbm.frf(c, stability=False)).items():
-        print(f"    {k:<50} {100 * v:5.1f} %")
+    print_profile(c)
     return dict(points=res.freq_hz.size, seconds=t, points_300=r300.freq_hz.size, seconds_300=t300)
 
 

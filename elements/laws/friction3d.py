@@ -79,33 +79,43 @@ def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A,
 
 
 @nb.njit(cache=True)
-def friction3d_step(p, s, z, s_new, A, B):
-    """One return-mapping step; ``A = ds_new/ds`` (ns, ns), ``B = ds_new/dz`` (ns, nt + 1)."""
-    kt = p[0]
+def _normal_and_slider(p, z, s_new, B):
+    """Slider positions ``u_t,prev = u_t`` and the normal force into ``s_new`` with their
+    derivatives in ``B`` (zeroed first); returns the normal load ``N`` (<= 0: open, then the
+    tangential forces are zero too)."""
     kn = p[1]
-    mu = p[2]
     N0 = p[3]
     nt = int(p[4])
-    un = z[nt]
-    A[:, :] = 0.0
+    w0 = nt + 1
     B[:, :] = 0.0
-    n_row = nt          # row of f_n in the state
-    w0 = nt + 1         # first row of u_t,prev
     for a in range(nt):
         s_new[w0 + a] = z[a]
         B[w0 + a, a] = 1.0
-    Nload = N0 + kn * un
+    Nload = N0 + kn * z[nt]
     if Nload <= 0.0:
         for a in range(nt):
             s_new[a] = 0.0
-        s_new[n_row] = -N0
+        s_new[nt] = -N0
+    else:
+        s_new[nt] = kn * z[nt]
+        B[nt, nt] = kn
+    return Nload
+
+
+@nb.njit(cache=True)
+def friction3d_step(p, s, z, s_new, A, B):
+    """One return-mapping step; ``A = ds_new/ds`` (ns, ns), ``B = ds_new/dz`` (ns, nt + 1)."""
+    kt = p[0]
+    nt = int(p[4])
+    w0 = nt + 1         # first row of u_t,prev (row nt: f_n)
+    A[:, :] = 0.0
+    Nload = _normal_and_slider(p, z, s_new, B)
+    if Nload <= 0.0:
         return
-    s_new[n_row] = kn * un
-    B[n_row, nt] = kn
     t0 = s[0] + kt * (z[0] - s[w0])
     t1 = s[1] + kt * (z[1] - s[w0 + 1]) if nt == 2 else 0.0
-    f0, f1, r, d0, d1, slipping = _radial_return(mu * Nload, t0, t1)
-    _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, True)
+    f0, f1, r, d0, d1, slipping = _radial_return(p[2] * Nload, t0, t1)
+    _write_tangential(kt, p[2], p[1], nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, True)
 
 
 @nb.njit(cache=True)
@@ -116,25 +126,10 @@ def friction3d_init(p, z0, s0, C0):
     zero if the contact is open.
     """
     kt = p[0]
-    kn = p[1]
-    mu = p[2]
-    N0 = p[3]
     nt = int(p[4])
-    un = z0[nt]
-    C0[:, :] = 0.0
-    n_row = nt
-    w0 = nt + 1
-    for a in range(nt):
-        s0[w0 + a] = z0[a]
-        C0[w0 + a, a] = 1.0
-    Nload = N0 + kn * un
+    Nload = _normal_and_slider(p, z0, s0, C0)
     if Nload <= 0.0:
-        for a in range(nt):
-            s0[a] = 0.0
-        s0[n_row] = -N0
         return
-    s0[n_row] = kn * un
-    C0[n_row, nt] = kn
     t1 = kt * z0[1] if nt == 2 else 0.0
-    f0, f1, r, d0, d1, slipping = _radial_return(mu * Nload, kt * z0[0], t1)
-    _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s0, C0, C0, False)
+    f0, f1, r, d0, d1, slipping = _radial_return(p[2] * Nload, kt * z0[0], t1)
+    _write_tangential(kt, p[2], p[1], nt, nt + 1, f0, f1, r, d0, d1, slipping, s0, C0, C0, False)
