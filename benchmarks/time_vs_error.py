@@ -325,18 +325,27 @@ def print_profile(case):
         print(f"    {k:<50} {100 * v:5.1f} %")
 
 
+def time_frfs(c, ds_max, repeat):
+    """CPU time of the FRF of ``c`` with default steps, with Hill stability, and with the
+    largest step ``ds_max`` (scaled units: the frequency range is 1; about 300 points).
+
+    Returns ``(t, res, t_stability, t_fine, res_fine)``.
+    """
+    hbm.frf(c, stability=False)
+    t, res = cpu(lambda: hbm.frf(c, stability=False), repeat=repeat)
+    t_st, _ = cpu(lambda: hbm.frf(c), repeat=max(1, repeat // 2))
+    opts = ArclengthOptions(ds_max=ds_max, ds0=ds_max)
+    t_fine, r_fine = cpu(lambda: hbm.frf(c, stability=False, options=opts), repeat=repeat)
+    return t, res, t_st, t_fine, r_fine
+
+
 def section_target():
     print("\n== 4. Target case: 3-DOF, two Jenkins, H = 7, N = 256")
     c = target_case()
-    hbm.frf(c, stability=False)
-    t, res = cpu(lambda: hbm.frf(c, stability=False), repeat=5)
-    t_st, _ = cpu(lambda: hbm.frf(c), repeat=2)
+    t, res, t_st, t300, r300 = time_frfs(c, 1.0 / 60, repeat=5)
     print(f"  FRF (default steps): {res.freq_hz.size} points, {res.iterations.sum()} Newton iterations, "
           f"{res.n_rejected} rejected steps, {t:.3f} s CPU ({t / res.freq_hz.size * 1e3:.2f} ms/point); "
           f"with Hill stability of every point {t_st:.3f} s")
-    # about 300 points: the largest step limited to 1/60 (scaled units: the frequency range is 1)
-    opts = ArclengthOptions(ds_max=1.0 / 60, ds0=1.0 / 60)
-    t300, r300 = cpu(lambda: hbm.frf(c, stability=False, options=opts), repeat=5)
     print(f"  FRF (ds_max = 1/60): {r300.freq_hz.size} points, {r300.iterations.sum()} Newton "
           f"iterations, {t300:.3f} s CPU ({t300 / r300.freq_hz.size * 1e3:.2f} ms/point; target: about 300 "
           f"points in 0.1 s)")
@@ -375,15 +384,10 @@ def section_upd_like():
     print("\n== 5. UPD-like rig: two beam blades, damper with two friction3d contacts, H = 3")
     data = tomllib.loads((ROOT / "benchmarks" / "upd_like.toml").read_text())
     c = case_from_dict(data, str(ROOT / "benchmarks" / "upd_like.toml"), ROOT / "benchmarks")
-    hbm.frf(c, stability=False)
-    t, res = cpu(lambda: hbm.frf(c, stability=False), repeat=3)
-    t_st, _ = cpu(lambda: hbm.frf(c), repeat=1)
+    t, res, t_st, t300, r300 = time_frfs(c, 1.0 / 130, repeat=3)
     print(f"  {c.n_dof} DOFs, solver {res.settings['solver']}: {res.freq_hz.size} points, "
           f"{res.iterations.sum()} Newton iterations, {t:.3f} s CPU ({t / res.freq_hz.size * 1e3:.2f} "
           f"ms/point); with Hill stability {t_st:.3f} s")
-    # about 300 points (the target's size): largest step 1/130 in scaled units
-    opts = ArclengthOptions(ds_max=1.0 / 130, ds0=1.0 / 130)
-    t300, r300 = cpu(lambda: hbm.frf(c, stability=False, options=opts), repeat=3)
     print(f"  FRF (ds_max = 1/130): {r300.freq_hz.size} points, {r300.iterations.sum()} Newton iterations, "
           f"{t300:.3f} s CPU (target: about 300 points in 0.3 s)")
     print_profile(c)

@@ -36,7 +36,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .kernels import law_step, law_init, _accumulate, _propagate
+from .kernels import law_step, rest_start, _accumulate, _propagate
 
 
 @nb.njit(cache=True)
@@ -106,9 +106,7 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     A = np.zeros((ns, ns))
     B = np.zeros((ns, nz))
     zj = np.empty(nz)
-    zj[:] = z[start]
-    law_init(kind, p, zj, s, B)
-    _propagate(A, B, ds_new, dz, start, ds)     # A = 0 here: ds = C0 dz[start]
+    rest_start(kind, p, z, dz, start, s, ds, zj, B)
     f = np.empty((N, n_local))
     df = np.empty((N, n_local, P))
     passes = 0

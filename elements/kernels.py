@@ -96,6 +96,16 @@ def _propagate(A, B, ds, dz, j, out):
 
 
 @nb.njit(cache=True)
+def rest_start(kind, p, z, dz, start, s, ds, zj, B):
+    """Rest state ``s`` at sample ``start`` and its seeds ``ds = C0 dz[start]``
+    (``zj`` (nz,) and ``B`` (ns, nz) are work arrays; ``ds`` is overwritten)."""
+    zj[:] = z[start]
+    law_init(kind, p, zj, s, B)
+    ds[:, :] = 0.0
+    _accumulate(B, dz[start], ds)
+
+
+@nb.njit(cache=True)
 def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     """March a law over one sampled period with forward-mode derivative seeds.
 
@@ -135,10 +145,7 @@ def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     A = np.zeros((n_state, n_state))
     B = np.zeros((n_state, nz))
     zj = np.empty(nz)
-    zj[:] = z[start]
-    law_init(kind, p, zj, s, B)
-    _propagate(A, B, ds, dz, start, ds_new)      # A = 0 here: ds = C0 dz[start]
-    ds, ds_new = ds_new, ds
+    rest_start(kind, p, z, dz, start, s, ds, zj, B)
     f = np.empty((N, n_local))
     df = np.empty((N, n_local, P))
     passes = 0
