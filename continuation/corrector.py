@@ -47,6 +47,7 @@ tangent when :math:`a` is the previous tangent.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -86,8 +87,9 @@ class Evaluation:
         # one pass over Js gives both: a NaN or inf entry makes its row sum and the
         # maximum NaN or inf (so does an overflowing sum, which is no usable Jacobian either)
         norm = float(np.abs(self.Js).sum(axis=1).max(initial=0.0))
-        r_max = float(np.abs(self.R).max(initial=0.0))
-        self._finite = bool(np.isfinite(norm) and np.isfinite(r_max))
+        R = self.R
+        r_max = max(float(R.max()), -float(R.min())) if R.size else 0.0
+        self._finite = math.isfinite(norm) and math.isfinite(r_max)
         self._row_norm = norm if self._finite else 0.0
         self.r_max = r_max      # ||R||_inf
 
@@ -201,13 +203,16 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     rhs = np.empty(n + 1)
     A = np.empty((n + 1, n + 1), order="F")     # refilled before every solve
     best = (np.inf, ev, 0)
+    sqrt_tol = math.sqrt(tol)
+    backtrack_below = max(1e3 * tol, sqrt_tol)
     history = []
     stalled = False
     for it in range(max_iter + 1):
         rho = max(rho0, ev.row_norm())
         res = ev.r_max / rho
         g, a = constraint(ev.xs)
-        size = 1.0 + float(np.abs(ev.xs).max())
+        xs = ev.xs
+        size = 1.0 + max(float(xs.max()), -float(xs.min()))
         converged = res <= tol and abs(g) <= tol * size
         if res < best[0] and abs(g) <= tol * size:
             best = (res, ev, it)
@@ -220,7 +225,7 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             break
         A[:n] = ev.Js
         A[n] = rho * a
-        rhs[:n] = -ev.R
+        np.negative(ev.R, out=rhs[:n])
         rhs[n] = -rho * g
         null = None
         if converged:
@@ -230,23 +235,24 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             B[n, 1] = rho
             sol = solve(A, B)
             delta, null = (None, None) if sol is None else (sol[:, 0], sol[:, 1])
+            if null is not None and not math.isfinite(float(null.sum())):
+                null = None
         else:
             delta = solve(A, rhs)
-        if delta is None or not np.all(np.isfinite(delta)):
+        if delta is None or not math.isfinite(float(delta.sum())):
             if converged:
                 return Correction(True, ev, it, res)
             return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
         if converged:
             # free polishing update: error ~ |delta|^2, no further call of the function
             return Correction(True, ev, it, res, xs=ev.xs + delta, null=null)
-        if np.abs(delta).max() <= 16 * _EPS * size and res <= np.sqrt(tol):
+        if res <= sqrt_tol and np.abs(delta).max() <= 16 * _EPS * size:
             return Correction(True, ev, it, res)
         merit = max(res, abs(g))
         theta = 1.0
         # near the solution (merit below sqrt(tol)) a full step is taken whatever it gives:
         # there the merit grows only when a stick-slip switch moves between samples, which a
         # shorter step does not cure (it would cost up to max_backtrack more evaluations)
-        backtrack_below = max(1e3 * tol, np.sqrt(tol))
         for _ in range(max_backtrack + 1):
             trial = evaluate(ev.xs + theta * delta)
             if trial.finite:
