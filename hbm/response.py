@@ -317,10 +317,10 @@ def _polish(problem, X, w, xscale, r_scale, err):
     ``|R| / |F|`` ~ 1e-9 and an energy error ~ 1e-6.  Here the target is relative to ``|F|``.
     Returns the better of the two points and its relative energy error.
     """
-    fun = lambda x: problem.residual(x.reshape(X.shape), w)[:2]
-    res = newton(fun, X.ravel(), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4)
+    fun = lambda u: problem.residual(problem.expand(u), w)[:2]
+    res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4)
     if np.all(np.isfinite(res.x)):
-        Xp = res.x.reshape(X.shape)
+        Xp = problem.expand(res.x)
         err_p = energy_balance(problem, Xp, w).relative_error
         if err_p < err:
             return Xp, err_p
