@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .aft import NonlinearForces
+from .dense_kernels import dense_residual
 from .fourier import FourierBasis
 from .linear import LinearModel, harmonic_blocks
 
@@ -88,6 +89,9 @@ class HarmonicBalance:
         if basis.n_coef * n <= self.TEMPLATE_MAX and all(isinstance(m, np.ndarray) for m in mats):
             self._templates = tuple(self._block_matrix(*parts) for parts in
                                     ((model.K, None, None), (None, model.C, None), (None, None, model.M)))
+        self._fex_flat = np.ascontiguousarray(self.Fex.reshape(-1))
+        nu_all = basis.n_coef * n
+        self._zero_forces = (np.zeros(nu_all), np.zeros((nu_all, nu_all)), np.zeros(nu_all))
 
     TEMPLATE_MAX = 600     # largest n_coef * n_dof for which Z0, Z1, Z2 are kept (3 n^2 floats)
 
@@ -215,6 +219,8 @@ class HarmonicBalance:
         """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]`` (n_u, n_u + 1)."""
         X = self.expand(x[:-1])
         w = float(x[-1])
+        if self._all_free and self._templates is not None and (self._nl_all or not self.nl.n_nl):
+            return self._dense_call(x, X, w)
         if self._all_free:
             nu = X.size
             Jw = np.zeros((nu, nu + 1))
@@ -223,6 +229,21 @@ class HarmonicBalance:
             return R.reshape(-1), Jw
         R, J, dw = self.residual(X, w)
         return R, np.hstack([J, dw[:, None]])
+
+    def _dense_call(self, x, X, w):
+        """:meth:`__call__` of a small dense model whose DOFs are all free and all touched
+        by elements (or none): one compiled assembly (:mod:`hbm.dense_kernels`)."""
+        nu = X.size
+        if self.nl.n_nl:
+            F, dF, dFw = self.nl.evaluate(X, w)
+        else:
+            F, dF, dFw = self._zero_forces
+        A = np.empty((nu, nu + 1))
+        R = np.empty(nu)
+        Z0, Z1, Z2 = self._templates
+        dense_residual(Z0, Z1, Z2, w, np.ascontiguousarray(x[:-1]), self._fex_flat, F.reshape(-1),
+                       dF, dFw.reshape(-1), A[:, :nu], R, A[:, nu])
+        return R, A
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
         """``F_nl`` on all DOFs, (n_coef, n)."""
