@@ -8,14 +8,9 @@ Step :math:`k \to k+1` with unit tangent :math:`t_k` and step :math:`ds`:
 
 .. math::
 
-    \text{predictor:}\quad x_{s,pred} = x_{s,k} + ds\, t_k + ds^2 c_k, \qquad
+    \text{predictor:}\quad x_{s,pred} = x_{s,k} + ds\, t_k, \qquad
     \text{corrector:}\quad R(s \odot x_s) = 0,\;\; t_k^T (x_s - x_{s,pred}) = 0,
 
-where :math:`c_k` is the curvature vector of the parabola through the last two points with
-the tangent :math:`t_k` (:func:`curvature`; left out after the first step, after a turn
-beyond ``max_angle_deg`` and where :math:`ds\,|c_k|` exceeds ``MAX_BEND``), so the predictor
-errs by :math:`O(ds^3)` instead of :math:`O(ds^2)` on a smooth path and Newton starts close
-enough to converge in one update at most points;
 then the new tangent :math:`t_{k+1}` spans the null space of :math:`J_s(x_{k+1})`
 (:mod:`continuation.tangent`) with the sign of the chord,
 :math:`t_{k+1}^T (x_{s,k+1} - x_{s,k}) > 0`.  A step is rejected (``ds`` halved) when Newton
@@ -79,29 +74,6 @@ def default_scale(x0: np.ndarray, lam_bounds: tuple[float, float]) -> np.ndarray
     if s[-1] <= 0:
         s[-1] = 1.0
     return s
-
-
-MAX_BEND = 0.25     # largest ds |curv| (about the turn of the tangent over a step) predicted
-
-
-def curvature(x0: np.ndarray, x1: np.ndarray, t1: np.ndarray) -> np.ndarray:
-    """Curvature vector ``c`` of the path at ``x1`` from the previous point ``x0``, so that
-    ``x(s) = x1 + s t1 + s^2 c`` passes through ``x0`` at ``s = -h`` (``h = |x1 - x0|``).
-
-    Parameters
-    ----------
-    x0, x1 : ndarray, shape (n+1,)
-        Consecutive points (scaled).
-    t1 : ndarray, shape (n+1,)
-        Unit tangent at ``x1``.
-
-    Returns
-    -------
-    ndarray, shape (n+1,)
-    """
-    d = x0 - x1
-    h2 = float(d @ d)
-    return (d + math.sqrt(h2) * t1) / h2
 
 
 def _sign(v: float) -> int:
@@ -256,8 +228,6 @@ class Arclength:
         lam_prev_sign = _sign(t[-1])
 
         ds = self.ds0
-        curv = None
-        max_angle = math.radians(o.max_angle_deg)
         steps = 0
         consecutive = 0
         angle_reject = None   # (ds, angle) of the last rejection for the angle
@@ -272,11 +242,11 @@ class Arclength:
                 self.message = f"parameter reached the bound lam={xs[-1] * s_lam:.6g}"
                 return
 
-            c, t_new, angle, reason, on_bound = self._step(xs, t, ds, angle_reject, False, curv)
+            c, t_new, angle, reason, on_bound = self._step(xs, t, ds, angle_reject, False)
             if reason is not None and consecutive >= 1 and not on_bound:
                 # repeated trouble at this point: maybe a sharp corner of the path, which a
                 # hyperplane normal to t cannot cross; try a sphere around the last point
-                c2, t2, a2, r2, b2 = self._step(xs, t, ds, angle_reject, True, None)
+                c2, t2, a2, r2, b2 = self._step(xs, t, ds, angle_reject, True)
                 if r2 is None or r2.startswith("the tangent turned"):
                     c, t_new, angle, reason, on_bound = c2, t2, a2, r2, b2
 
@@ -312,7 +282,6 @@ class Arclength:
                                 f"lam={c.xs[-1] * s_lam:.6g} after {steps} steps, "
                                 f"{len(self.folds)} folds, {self.n_rejected} rejections")
                 return
-            curv = None if angle > max_angle else curvature(xs, c.xs, t_new)
             xs = c.xs
             t = t_new
             factor = math.sqrt(o.target_iter / max(c.iterations, 1))
@@ -329,11 +298,8 @@ class Arclength:
             ds = min(max(ds * factor, self.ds_min), self.ds_max)
             consecutive = 0
 
-    def _step(self, xs, t, ds, angle_reject, sphere, curv):
+    def _step(self, xs, t, ds, angle_reject, sphere):
         """Predict and correct one step; return ``(c, t_new, angle, reason, on_bound)``.
-
-        ``curv`` (n+1,) is the path's curvature vector at ``xs`` estimated from the last
-        chord (:func:`curvature`), or None: the predictor is then the tangent line.
 
         ``reason`` is ``None`` when the step is acceptable.  ``sphere`` replaces the
         hyperplane ``t @ (xs' - pred) = 0`` by the sphere ``|xs' - xs| = ds``, which may turn
@@ -345,8 +311,6 @@ class Arclength:
         lo_s, hi_s = self.lam_bounds[0] / s_lam, self.lam_bounds[1] / s_lam
         max_angle = math.radians(o.max_angle_deg)
         pred = xs + ds * t
-        if curv is not None and ds * _norm(curv) <= MAX_BEND:
-            pred += (ds * ds) * curv
         start = pred
         on_bound = False
         bound = hi_s if pred[-1] > hi_s else lo_s if pred[-1] < lo_s else None

@@ -40,9 +40,7 @@ class ArclengthOptions:
         Largest number of accepted steps after the starting point (status ``'max_steps'``).
     tol : float
         Newton tolerance on the scaled residual ``||R||_inf / rho`` (see
-        :mod:`continuation.corrector`).  The corrector's last, free update squares the
-        error of a smooth problem, so ``1e-9`` lands near machine precision; a stricter
-        value costs one more function call at most points.
+        :mod:`continuation.corrector`); ``1e-10`` lands near machine precision.
     max_iter : int
         Newton iterations allowed per corrector.
     target_iter : int
@@ -65,7 +63,7 @@ class ArclengthOptions:
     ds_min: float | None = None
     ds_max: float | None = None
     max_steps: int = 2000
-    tol: float = 1e-9
+    tol: float = 1e-10
     max_iter: int = 12
     target_iter: int = 4
     max_angle_deg: float = 15.0

@@ -302,22 +302,3 @@ def test_corrector_gives_up_early_when_newton_stalls():
     assert not c.converged and "no convergence in 12" in c.reason and len(calls) == 1 + 12 * 3
 
 
-
-def test_curvature_predictor_on_a_circle():
-    """The parabola through two points of a circle (radius r) with the tangent at the second
-    has the curvature vector -n / (2 r) (n the outward normal): with the last step as long as
-    the next, the predictor errs by O(ds^3) against O(ds^2) for the tangent line."""
-    from continuation.arclength import curvature
-    r, a1 = 2.0, 0.35
-    p = lambda a: r * np.array([np.cos(a), np.sin(a)])
-    t1 = np.array([-np.sin(a1), np.cos(a1)])
-    errs_line, errs_quad = [], []
-    for ds in (0.04, 0.02):
-        c = curvature(p(a1 - ds / r), p(a1), t1)
-        assert np.abs(c + p(a1) / r / (2 * r)).max() < ds / r
-        target = p(a1 + ds / r)
-        errs_line.append(np.linalg.norm(p(a1) + ds * t1 - target))
-        errs_quad.append(np.linalg.norm(p(a1) + ds * t1 + ds * ds * c - target))
-    assert errs_quad[0] < 0.1 * errs_line[0]
-    assert errs_line[0] / errs_line[1] == pytest.approx(4, rel=0.05)     # O(ds^2)
-    assert errs_quad[0] / errs_quad[1] > 7                                # O(ds^3)
