@@ -300,5 +300,3 @@ def test_corrector_gives_up_early_when_newton_stalls():
     calls.clear()
     c = correct(evaluate, np.zeros(2), con, None, 1e-10, 12, 2, stall_window=0)
     assert not c.converged and "no convergence in 12" in c.reason and len(calls) == 1 + 12 * 3
-
-
