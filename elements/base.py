@@ -140,12 +140,11 @@ class Element:
         f : ndarray, shape (N, n_local)
         df : ndarray, shape (N, n_local, P)
         """
-        from .law_march import march_for
-        f, df, passes = march_for(self.closure)(self.kind, self.params, self.n_state, self.n_local,
-                                                np.ascontiguousarray(z, dtype=float),
-                                                np.ascontiguousarray(dz, dtype=float),
-                                                self.start_index(z[:, :self.n_local]),
-                                                self.max_passes, self.closure_tol)
+        from .law_march import march_of
+        m = march_of(self.kind, self.closure)
+        f, df, passes = m(self.params, self.n_state, self.n_local,
+                          np.ascontiguousarray(z, dtype=float), np.ascontiguousarray(dz, dtype=float),
+                          self.start_index(z[:, :self.n_local]), self.max_passes, self.closure_tol)
         return f, df
 
     def linear_stiffness(self) -> np.ndarray:

@@ -36,7 +36,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .kernels import law_step, rest_start, _accumulate, _propagate
+from .kernels import law_step_inline, rest_start, propagate
 
 
 @nb.njit(cache=True)
@@ -89,24 +89,27 @@ def _solve_small(K, R):
     return W[:, n:n + m].copy(), norm_k * norm_inv
 
 
-@nb.njit(cache=True)
-def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
-    """Same interface as :func:`elements.kernels.march`, with Newton closure (module doc)."""
+@nb.njit(inline="always")
+def newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
+    """Body of :func:`march_newton`, inlined into its callers.
+
+    The period map's derivative ``M`` is propagated like the seeds (``M_j = A_j M_{j-1}``), in
+    two parity buffers; the state is copied back (no array swaps).
+    """
     N, nz = z.shape
     P = dz.shape[2]
     ns = n_state
     s = np.zeros(ns)
     s_new = np.zeros(ns)
     s_begin = np.zeros(ns)
-    ds = np.zeros((ns, P))
-    ds_new = np.zeros((ns, P))
+    D = np.zeros((2, ns, P))
     ds_begin = np.zeros((ns, P))
-    Ms = np.zeros((ns, ns))
-    Ms_new = np.zeros((ns, ns))
+    MS = np.zeros((2, ns, ns))
     A = np.zeros((ns, ns))
     B = np.zeros((ns, nz))
     zj = np.empty(nz)
-    rest_start(kind, p, z, dz, start, s, ds, zj, B)
+    rest_start(kind, p, z, dz, start, s, D, zj, B)
+    cur = 0
     f = np.empty((N, n_local))
     df = np.empty((N, n_local, P))
     passes = 0
@@ -117,24 +120,43 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     eye = np.eye(ns)
     while passes < max_passes and not closed:
         passes += 1
-        s_begin[:] = s
-        ds_begin[:, :] = ds
-        Ms[:, :] = eye
-        for jj in range(1, N + 1):
-            j = (start + jj) % N
+        for i in range(ns):
+            s_begin[i] = s[i]
+            for c in range(P):
+                ds_begin[i, c] = D[cur, i, c]
+        mc = 0
+        MS[0, :, :] = eye
+        j = start
+        for jj in range(N):
+            j += 1
+            if j >= N:
+                j = 0
             for k in range(nz):
                 zj[k] = z[j, k]
-            law_step(kind, p, s, zj, s_new, A, B)
-            _propagate(A, B, ds, dz, j, ds_new)
-            Ms_new[:, :] = 0.0
-            _accumulate(A, Ms, Ms_new)
-            s, s_new = s_new, s
-            ds, ds_new = ds_new, ds
-            Ms, Ms_new = Ms_new, Ms
+            law_step_inline(kind, p, s, zj, s_new, A, B)
+            for i in range(ns):
+                s[i] = s_new[i]
             for a in range(n_local):
                 f[j, a] = s[a]
-                for c in range(P):
-                    df[j, a, c] = ds[a, c]
+            # M <- A M (A is small and sparse)
+            mn = 1 - mc
+            for i in range(ns):
+                for c in range(ns):
+                    MS[mn, i, c] = 0.0
+                for k in range(ns):
+                    m = A[i, k]
+                    if m != 0.0:
+                        for c in range(ns):
+                            MS[mn, i, c] += m * MS[mc, k, c]
+            mc = mn
+            if P > 0:
+                propagate(A, B, D, cur, dz, j)
+                cur = 1 - cur
+                for a in range(n_local):
+                    for c in range(P):
+                        df[j, a, c] = D[cur, a, c]
+        Ms = MS[mc]
+        ds = D[cur]
         scale = 0.0
         res = 0.0
         for i in range(ns):
@@ -176,3 +198,12 @@ def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     if not closed:
         passes = -passes
     return f, df, passes
+
+
+@nb.njit(cache=True)
+def march_newton(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
+    """Same interface as :func:`elements.kernels.march`, with Newton closure (module doc).
+
+    Generic in ``kind``; :func:`elements.law_march.march_of` gives it compiled for one law.
+    """
+    return newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol)

@@ -30,8 +30,7 @@ from .laws.friction3d import friction3d_step, friction3d_init
 from .laws.coulomb import coulomb_sk_step, coulomb_sk_init, coulomb_reg_step, coulomb_reg_init
 
 
-@nb.njit(cache=True)
-def law_step(kind, p, s, z, s_new, A, B):
+def _law_step(kind, p, s, z, s_new, A, B):
     """Dispatch one incremental update to the law ``kind`` (see module docstring)."""
     if kind == JENKINS:
         jenkins_step(p, s, z, s_new, A, B)
@@ -47,8 +46,7 @@ def law_step(kind, p, s, z, s_new, A, B):
         raise ValueError("unknown law kind")
 
 
-@nb.njit(cache=True)
-def law_init(kind, p, z0, s0, C0):
+def _law_init(kind, p, z0, s0, C0):
     """Rest state ``s0`` at input ``z0`` reached from ``q = 0``, and ``C0 = ds0/dz0``."""
     if kind == JENKINS:
         jenkins_init(p, z0, s0, C0)
@@ -64,6 +62,16 @@ def law_init(kind, p, z0, s0, C0):
         raise ValueError("unknown law kind")
 
 
+# One dispatch text, two compilations: a called kernel for the time integrator
+# (hbm.timesim, ``kind`` varies per element), and an inlined one for the marches, where a
+# constant ``kind`` (elements.law_march.march_of) lets numba prune the other laws' branches
+# before typing, so that only the marched law is compiled, inlined into the sample loop.
+law_step = nb.njit(cache=True)(_law_step)
+law_init = nb.njit(cache=True)(_law_init)
+law_step_inline = nb.njit(inline="always")(_law_step)
+law_init_inline = nb.njit(inline="always")(_law_init)
+
+
 @nb.njit(cache=True)
 def _accumulate(M, X, out):
     """``out += M @ X`` skipping zero entries of the small matrix ``M``."""
@@ -75,39 +83,118 @@ def _accumulate(M, X, out):
                     out[i, c] += m * X[k, c]
 
 
-@nb.njit(cache=True)
-def _propagate(A, B, ds, dz, j, out):
-    """``out = A @ ds + B @ dz[j]`` skipping zero entries of the small matrices ``A``, ``B``
-    (``dz`` indexed in place: no per-sample view)."""
-    P = ds.shape[1]
+@nb.njit(inline="always")
+def propagate(A, B, D, cur, dz, j):
+    """``D[1 - cur] = A @ D[cur] + B @ dz[j]`` for the seed buffers ``D`` (2, ns, P), skipping
+    zero entries of the small matrices ``A``, ``B`` (all indexed in place: no views)."""
+    nxt = 1 - cur
+    P = D.shape[2]
     for i in range(A.shape[0]):
-        for c in range(P):
-            out[i, c] = 0.0
+        first = True
         for k in range(A.shape[1]):
             m = A[i, k]
             if m != 0.0:
-                for c in range(P):
-                    out[i, c] += m * ds[k, c]
+                if first:
+                    for c in range(P):
+                        D[nxt, i, c] = m * D[cur, k, c]
+                    first = False
+                else:
+                    for c in range(P):
+                        D[nxt, i, c] += m * D[cur, k, c]
         for k in range(B.shape[1]):
             m = B[i, k]
             if m != 0.0:
-                for c in range(P):
-                    out[i, c] += m * dz[j, k, c]
+                if first:
+                    for c in range(P):
+                        D[nxt, i, c] = m * dz[j, k, c]
+                    first = False
+                else:
+                    for c in range(P):
+                        D[nxt, i, c] += m * dz[j, k, c]
+        if first:
+            for c in range(P):
+                D[nxt, i, c] = 0.0
 
 
-@nb.njit(cache=True)
-def rest_start(kind, p, z, dz, start, s, ds, zj, B):
-    """Rest state ``s`` at sample ``start`` and its seeds ``ds = C0 dz[start]``
-    (``zj`` (nz,) and ``B`` (ns, nz) are work arrays; ``ds`` is overwritten)."""
-    zj[:] = z[start]
-    law_init(kind, p, zj, s, B)
-    ds[:, :] = 0.0
-    _accumulate(B, dz[start], ds)
+@nb.njit(inline="always")
+def rest_start(kind, p, z, dz, start, s, D, zj, B):
+    """Rest state ``s`` at sample ``start`` and its seeds ``D[0] = C0 dz[start]``
+    (``zj`` (nz,) and ``B`` (ns, nz) are work arrays; ``D`` (2, ns, P) is overwritten)."""
+    for k in range(zj.shape[0]):
+        zj[k] = z[start, k]
+    law_init_inline(kind, p, zj, s, B)
+    D[:, :, :] = 0.0
+    for i in range(B.shape[0]):
+        for k in range(B.shape[1]):
+            m = B[i, k]
+            if m != 0.0:
+                for c in range(D.shape[2]):
+                    D[0, i, c] += m * dz[start, k, c]
+
+
+@nb.njit(inline="always")
+def march_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
+    """Body of :func:`march`, inlined into its callers (see :func:`march`).
+
+    The sample loop copies the small state back (no array swaps: each costs reference-count
+    updates) and keeps the seeds in two buffers selected by parity; with ``P = 0`` seeds no
+    seed work is done at all.
+    """
+    N, nz = z.shape
+    P = dz.shape[2]
+    ns = n_state
+    s = np.zeros(ns)
+    s_new = np.zeros(ns)
+    s_begin = np.zeros(ns)
+    D = np.zeros((2, ns, P))
+    A = np.zeros((ns, ns))
+    B = np.zeros((ns, nz))
+    zj = np.empty(nz)
+    rest_start(kind, p, z, dz, start, s, D, zj, B)
+    cur = 0
+    f = np.empty((N, n_local))
+    df = np.empty((N, n_local, P))
+    passes = 0
+    closed = False
+    while passes < max_passes and not closed:
+        passes += 1
+        for i in range(ns):
+            s_begin[i] = s[i]
+        j = start
+        for jj in range(N):
+            j += 1
+            if j >= N:
+                j = 0
+            for k in range(nz):
+                zj[k] = z[j, k]
+            law_step_inline(kind, p, s, zj, s_new, A, B)
+            for i in range(ns):
+                s[i] = s_new[i]
+            for a in range(n_local):
+                f[j, a] = s[a]
+            if P > 0:
+                propagate(A, B, D, cur, dz, j)
+                cur = 1 - cur
+                for a in range(n_local):
+                    for c in range(P):
+                        df[j, a, c] = D[cur, a, c]
+        scale = 0.0
+        diff = 0.0
+        for i in range(ns):
+            scale = max(scale, abs(s[i]), abs(s_begin[i]))
+            diff = max(diff, abs(s[i] - s_begin[i]))
+        closed = diff <= tol * scale or scale == 0.0
+    if not closed:
+        passes = -passes
+    return f, df, passes
 
 
 @nb.njit(cache=True)
 def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     """March a law over one sampled period with forward-mode derivative seeds.
+
+    Generic in ``kind`` (all laws compiled in); :func:`elements.law_march.march_of` gives the
+    same march compiled for one law.
 
     Parameters
     ----------
@@ -120,7 +207,7 @@ def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     z : ndarray, shape (N, nz)
         Inputs at the N samples of one period.
     dz : ndarray, shape (N, nz, P)
-        Derivative seeds of the inputs.
+        Derivative seeds of the inputs (``P = 0``: forces only).
     start : int
         Sample at which the march starts from the rest state.
     max_passes : int
@@ -135,44 +222,4 @@ def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     passes : int
         Periods marched (the last one recorded); ``-passes`` if the loop did not close.
     """
-    N, nz = z.shape
-    P = dz.shape[2]
-    s = np.zeros(n_state)
-    s_new = np.zeros(n_state)
-    s_begin = np.zeros(n_state)
-    ds = np.zeros((n_state, P))
-    ds_new = np.zeros((n_state, P))
-    A = np.zeros((n_state, n_state))
-    B = np.zeros((n_state, nz))
-    zj = np.empty(nz)
-    rest_start(kind, p, z, dz, start, s, ds, zj, B)
-    f = np.empty((N, n_local))
-    df = np.empty((N, n_local, P))
-    passes = 0
-    closed = False
-    while passes < max_passes and not closed:
-        passes += 1
-        s_begin[:] = s
-        for jj in range(1, N + 1):
-            j = start + jj
-            if j >= N:
-                j -= N
-            for k in range(nz):
-                zj[k] = z[j, k]
-            law_step(kind, p, s, zj, s_new, A, B)
-            _propagate(A, B, ds, dz, j, ds_new)
-            s, s_new = s_new, s
-            ds, ds_new = ds_new, ds
-            for a in range(n_local):
-                f[j, a] = s[a]
-                for c in range(P):
-                    df[j, a, c] = ds[a, c]
-        scale = 0.0
-        diff = 0.0
-        for i in range(n_state):
-            scale = max(scale, abs(s[i]), abs(s_begin[i]))
-            diff = max(diff, abs(s[i] - s_begin[i]))
-        closed = diff <= tol * scale or scale == 0.0
-    if not closed:
-        passes = -passes
-    return f, df, passes
+    return march_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol)

@@ -28,8 +28,8 @@ import numba as nb
 import numpy as np
 
 from .kinds import JENKINS, FRICTION3D
-from .kernels import march
-from .closure import march_newton
+from .kernels import march, march_body
+from .closure import march_newton, newton_body
 
 START_FIRST = 0
 START_ARGMAX = 1
@@ -153,6 +153,38 @@ def linear_shortcut(kind, p, z, K, f0):
 
 def march_for(closure):
     """:func:`elements.kernels.march` or :func:`elements.closure.march_newton` by ``closure``
-    (chosen here, in Python: one compiled function calling both would make numba compile and
-    link both closures for every law)."""
+    (generic in the law: every law compiled in).  Prefer :func:`march_of`."""
     return march_newton if closure == CLOSE_NEWTON else march
+
+
+def make_law_march(kind, closure):
+    """A march compiled for one law and closure: ``m(p, n_state, n_local, z, dz, start,
+    max_passes, tol) -> (f, df, passes)``, the interface of :func:`elements.kernels.march`.
+
+    ``kind`` and ``closure`` are constants of the compiled function (closure cells holding
+    plain ints, which numba's cache keys by value), so numba prunes the other laws' branches
+    of the inlined dispatch before typing: only this law is compiled, with its step inlined
+    into the sample loop.  Use :func:`march_of`, which builds each one once per process.
+    """
+    kind = int(kind)
+    newton = int(closure) == CLOSE_NEWTON
+
+    @nb.njit(cache=True)
+    def law_march(p, n_state, n_local, z, dz, start, max_passes, tol):
+        if newton:
+            return newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol)
+        return march_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol)
+
+    return law_march
+
+
+_LAW_MARCHES = {}   # (kind, closure) -> compiled march: a memo of compiled code only
+
+
+def march_of(kind, closure):
+    """The march of law ``kind`` with closure ``closure`` (:func:`make_law_march`), built once."""
+    key = (int(kind), int(closure))
+    m = _LAW_MARCHES.get(key)
+    if m is None:
+        m = _LAW_MARCHES[key] = make_law_march(*key)
+    return m

@@ -18,19 +18,20 @@ follow without marching or transforming, ``P f = K U + f_0 e_0`` (``e_0`` the me
 
 This is the path :class:`hbm.aft.NonlinearForces` takes for law elements when the
 transform is the DFT matrix (few harmonics); it returns the same numbers as the generic path
-(element ``march`` between transform calls), to round-off.  One compiled function per closure
-(:func:`aft_plain`, :func:`aft_newton`), each calling only its own march: a single function
-dispatching to both closures made numba link and re-optimise both (with their LAPACK calls)
-into it, which multiplied the first run's compile time (measured: 16 s -> 59 s CPU for the
-default rig; now about 22 s).  The steps avoid BLAS/LAPACK bindings where loops do.
+(element ``march`` between transform calls), to round-off.  One compiled function per law
+and closure (:func:`make_aft_law`), with the law's step inlined into the march: a single
+function dispatching to both closures made numba link and re-optimise both (with their LAPACK
+calls) into it, which multiplied the first run's compile time (measured: 16 s -> 59 s CPU for
+the default rig), and a march generic in the law compiles every law and calls its step per
+sample.  The steps avoid BLAS/LAPACK bindings where loops do.
 """
 from __future__ import annotations
 
 import numba as nb
 import numpy as np
 
-from elements.closure import march_newton
-from elements.kernels import march
+from elements.closure import newton_body
+from elements.kernels import march_body
 from elements.law_march import CLOSE_NEWTON, linear_shortcut, start_sample
 
 
@@ -43,7 +44,7 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
     kind, p, start_rule, n_start, velocity
         The law (:class:`elements.base.LawSpec`).
     seeds : bool
-        Seed the march with ``dz/dU`` (and ``dz/dw``); False: one zero seed (forces only).
+        Seed the march with ``dz/dU`` (and ``dz/dw``); False: no seeds (forces only).
     G : ndarray, shape (n_l, n_nl)
     X : ndarray, shape (n_coef, n_nl)
         Coefficients of the nonlinear DOFs.
@@ -56,7 +57,7 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
     U : ndarray, shape (n_coef, n_l)
     z : ndarray, shape (N, n_z)
     dz : ndarray, shape (N, n_z, P)
-        ``P = n_coef n_l + 1`` with seeds, else 1 (zero).
+        ``P = n_coef n_l + 1`` with seeds, else 0.
     start : int
         Start sample of the march.
     linear : bool
@@ -91,20 +92,25 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
                 z[j, nl + a] = w * dth[j, a]
     K = np.zeros((nl, nz))
     f0 = np.zeros(nl)
-    Pc = nc * nl + 1 if seeds else 1
+    Pc = nc * nl + 1 if seeds else 0
     linear = (not velocity) and linear_shortcut(kind, p, z, K, f0)
     if linear:
         return U, z, np.zeros((0, nz, Pc)), 0, True, K, f0
-    dz = np.zeros((N, nz, Pc))
+    dz = np.empty((N, nz, Pc))     # every entry written once below (no zero fill first)
     if seeds:
         for j in range(N):
             for a in range(nl):
                 for m in range(nc):
-                    dz[j, a, m * nl + a] = E[j, m]
+                    e = E[j, m]
+                    for b in range(nl):
+                        dz[j, a, m * nl + b] = e if a == b else 0.0
+                dz[j, a, Pc - 1] = 0.0
             if velocity:
                 for a in range(nl):
                     for m in range(nc):
-                        dz[j, nl + a, m * nl + a] = w * dE[j, m]
+                        de = w * dE[j, m]
+                        for b in range(nl):
+                            dz[j, nl + a, m * nl + b] = de if a == b else 0.0
                     dz[j, nl + a, Pc - 1] = dth[j, a]
     return U, z, dz, start_sample(start_rule, n_start, z), False, K, f0
 
@@ -194,32 +200,48 @@ def aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds):
     _gather(G, Fe, dFe, F, J4, dFdw, seeds)
 
 
-@nb.njit(cache=True)
-def aft_plain(kind, p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
-              G, X, w, E, dE, P, row0, F, J4, dFdw):
-    """The three steps in one call for laws closed by plain passes (:func:`aft_law`)."""
-    U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
-                                                G, X, w, E, dE)
-    if linear:
-        aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
-        return 0
-    f, df, passes = march(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
-    aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
-    return passes
+def make_aft_law(kind, closure):
+    """The three steps (inputs, march, analysis + gather) compiled for one law and closure:
+    ``run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds, G, X, w, E, dE, P,
+    row0, F, J4, dFdw) -> passes`` (arguments as :func:`aft_law`).
+
+    ``kind`` and ``closure`` are constants of the compiled function (ints in its closure cells,
+    which numba's cache keys by value): numba prunes the other laws and the other closure
+    before typing, so only this law's march is compiled, its step inlined into the sample
+    loop (:func:`elements.law_march.make_law_march`).  Use :func:`aft_of`.
+    """
+    kind = int(kind)
+    newton = int(closure) == CLOSE_NEWTON
+
+    @nb.njit(cache=True)
+    def run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
+            G, X, w, E, dE, P, row0, F, J4, dFdw):
+        U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
+                                                    G, X, w, E, dE)
+        if linear:
+            aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
+            return 0
+        if newton:
+            f, df, passes = newton_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
+        else:
+            f, df, passes = march_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
+        aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
+        return passes
+
+    return run
 
 
-@nb.njit(cache=True)
-def aft_newton(kind, p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
-               G, X, w, E, dE, P, row0, F, J4, dFdw):
-    """The three steps in one call for laws closed by Newton (:func:`aft_law`)."""
-    U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
-                                                G, X, w, E, dE)
-    if linear:
-        aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
-        return 0
-    f, df, passes = march_newton(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
-    aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
-    return passes
+_AFT_LAWS = {}      # (kind, closure) -> compiled run: a memo of compiled code only
+_NO_J4 = np.zeros((0, 0, 0, 0))
+
+
+def aft_of(kind, closure):
+    """:func:`make_aft_law` of ``(kind, closure)``, built once per process."""
+    key = (int(kind), int(closure))
+    run = _AFT_LAWS.get(key)
+    if run is None:
+        run = _AFT_LAWS[key] = make_aft_law(*key)
+    return run
 
 
 def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
@@ -239,17 +261,17 @@ def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
     F : ndarray, shape (n_coef, n_nl)
     J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl), optional
     dFdw : ndarray, shape (n_coef, n_nl), optional
-        All accumulated in place.
+        All accumulated in place.  Without them the march carries no seeds at all.
 
     Returns
     -------
     passes : int
         Periods marched (0: linear shortcut; negative: the loop did not close).
     """
-    seeds = J4 is not None
-    if not seeds:
-        J4 = np.zeros((0, 0, 0, 0))
-        dFdw = F
-    run = aft_newton if spec.closure == CLOSE_NEWTON else aft_plain
-    return run(spec.kind, spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity,
-               spec.max_passes, spec.tol, seeds, G, X, w, E, dE, P, row0, F, J4, dFdw)
+    if J4 is None:
+        return aft_of(spec.kind, spec.closure)(
+            spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
+            spec.tol, False, G, X, w, E, dE, P, row0, F, _NO_J4, F)
+    return aft_of(spec.kind, spec.closure)(
+        spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
+        spec.tol, True, G, X, w, E, dE, P, row0, F, J4, dFdw)

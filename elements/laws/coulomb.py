@@ -38,7 +38,7 @@ LINEAR = 0
 ARCTAN = 1
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def coulomb_sk_step(p, s, z, s_new, A, B):
     """One stick/slide step; ``A`` (3, 3), ``B`` (3, 1)."""
     kt = p[0]
@@ -47,8 +47,12 @@ def coulomb_sk_step(p, s, z, s_new, A, B):
     fk = p[3] * Nload          # sliding limit
     u = z[0]
     ft = s[0] + kt * (u - s[1])
-    A[:, :] = 0.0
-    B[:, :] = 0.0
+    for i in range(A.shape[0]):      # explicit loops: a slice fill costs more per sample
+        for k in range(A.shape[1]):
+            A[i, k] = 0.0
+    for i in range(B.shape[0]):      # explicit loops: a slice fill costs more per sample
+        for k in range(B.shape[1]):
+            B[i, k] = 0.0
     sliding = s[2] > 0.5
     if sliding and ft * s[0] > 0.0 and abs(ft) > fk:
         s_new[0] = fk if s[0] > 0.0 else -fk
@@ -66,7 +70,7 @@ def coulomb_sk_step(p, s, z, s_new, A, B):
     B[1, 0] = 1.0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def coulomb_sk_init(p, z0, s0, C0):
     """Rest state at ``z0`` reached from ``q = 0`` monotonically: stuck at ``kt u0`` unless that
     exceeds ``mu_s N``, in which case the contact broke loose and slides at ``mu_k N``."""
@@ -74,7 +78,9 @@ def coulomb_sk_init(p, z0, s0, C0):
     fs = p[2] * p[1]
     fk = p[3] * p[1]
     f = kt * z0[0]
-    C0[:, :] = 0.0
+    for i in range(C0.shape[0]):      # explicit loops: a slice fill costs more per sample
+        for k in range(C0.shape[1]):
+            C0[i, k] = 0.0
     if abs(f) <= fs:
         s0[0] = f
         s0[2] = 0.0
@@ -86,7 +92,7 @@ def coulomb_sk_init(p, z0, s0, C0):
     C0[1, 0] = 1.0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _regularised(p, v):
     """Force and its derivative with respect to the velocity."""
     F0 = p[0]
@@ -101,7 +107,7 @@ def _regularised(p, v):
     return F0 * x, F0 / vr
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def coulomb_reg_step(p, s, z, s_new, A, B):
     """``f = Ft0 g(v / v_r)``; ``A`` (1, 1) = 0, ``B`` (1, 2) = [0, df/dv]."""
     f, dfdv = _regularised(p, z[1])
@@ -111,7 +117,7 @@ def coulomb_reg_step(p, s, z, s_new, A, B):
     B[0, 1] = dfdv
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def coulomb_reg_init(p, z0, s0, C0):
     f, dfdv = _regularised(p, z0[1])
     s0[0] = f

@@ -40,7 +40,7 @@ import math
 import numba as nb
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _radial_return(limit, t0, t1):
     """Return mapping of the trial force ``(t0, t1)`` (``t1 = 0`` for one direction) onto the
     circle of radius ``limit``: ``(f0, f1, r, d0, d1, slipping)`` with ``d = f^{tr}/|f^{tr}|``
@@ -55,7 +55,7 @@ def _radial_return(limit, t0, t1):
     return limit * d0, limit * d1, r, d0, d1, True
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, with_A):
     """Tangential forces into ``s_new`` and their derivatives (module doc) into ``A``
     (if ``with_A``: ``df_t/df_prev = J``, ``df_t/du_prev = -kt J``) and ``B``
@@ -78,7 +78,7 @@ def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A,
         B[a, nt] = mu * kn * da if slipping else 0.0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _normal_and_slider(p, z, s_new, B):
     """Slider positions ``u_t,prev = u_t`` and the normal force into ``s_new`` with their
     derivatives in ``B`` (zeroed first); returns the normal load ``N`` (<= 0: open, then the
@@ -87,7 +87,9 @@ def _normal_and_slider(p, z, s_new, B):
     N0 = p[3]
     nt = int(p[4])
     w0 = nt + 1
-    B[:, :] = 0.0
+    for i in range(B.shape[0]):      # explicit loops: a slice fill costs more per sample
+        for k in range(B.shape[1]):
+            B[i, k] = 0.0
     for a in range(nt):
         s_new[w0 + a] = z[a]
         B[w0 + a, a] = 1.0
@@ -102,13 +104,15 @@ def _normal_and_slider(p, z, s_new, B):
     return Nload
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def friction3d_step(p, s, z, s_new, A, B):
     """One return-mapping step; ``A = ds_new/ds`` (ns, ns), ``B = ds_new/dz`` (ns, nt + 1)."""
     kt = p[0]
     nt = int(p[4])
     w0 = nt + 1         # first row of u_t,prev (row nt: f_n)
-    A[:, :] = 0.0
+    for i in range(A.shape[0]):      # explicit loops: a slice fill costs more per sample
+        for k in range(A.shape[1]):
+            A[i, k] = 0.0
     Nload = _normal_and_slider(p, z, s_new, B)
     if Nload <= 0.0:
         return
@@ -118,7 +122,7 @@ def friction3d_step(p, s, z, s_new, A, B):
     _write_tangential(kt, p[2], p[1], nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, True)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def friction3d_init(p, z0, s0, C0):
     """Rest state reached at ``z0`` from ``q = 0`` without reversal, ``C0 = ds0/dz0``.
 

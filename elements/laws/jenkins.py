@@ -18,15 +18,14 @@ from __future__ import annotations
 import numba as nb
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def jenkins_step(p, s, z, s_new, A, B):
-    """One return-mapping step; writes ``s_new``, ``A = ds_new/ds`` (2, 2), ``B = ds_new/dz`` (2, 1)."""
+    """One return-mapping step; writes ``s_new``, ``A = ds_new/ds`` (2, 2), ``B = ds_new/dz`` (2, 1)
+    (every entry: no zeroing of A and B per sample)."""
     kt = p[0]
     fs = p[1]
     u = z[0]
     ft = s[0] + kt * (u - s[1])
-    A[:, :] = 0.0
-    B[:, :] = 0.0
     if abs(ft) <= fs:
         s_new[0] = ft
         A[0, 0] = 1.0
@@ -34,11 +33,16 @@ def jenkins_step(p, s, z, s_new, A, B):
         B[0, 0] = kt
     else:
         s_new[0] = fs if ft > 0.0 else -fs
+        A[0, 0] = 0.0
+        A[0, 1] = 0.0
+        B[0, 0] = 0.0
+    A[1, 0] = 0.0
+    A[1, 1] = 0.0
     s_new[1] = u
     B[1, 0] = 1.0
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def jenkins_init(p, z0, s0, C0):
     """Rest state reached at ``z0`` from ``q = 0``; ``C0 = ds0/dz0`` (2, 1)."""
     kt = p[0]
