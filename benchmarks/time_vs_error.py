@@ -293,7 +293,7 @@ PROFILE_GROUPS = (
     ("element march + AFT (numba)", lambda f, n: "aft_kernel" in f or "law_march" in f or "closure" in f),
     ("dense linear solves (LAPACK)", lambda f, n: ("linalg" in f or "corrector" in f)
      and n in ("solve", "inv", "eig", "eigvals")),
-    ("linear part Z(w) X", lambda f, n: n in ("linear_part", "_linear", "_receptances")),
+    ("linear part Z(w) X", lambda f, n: n in ("linear_part", "_linear", "_receptances", "dense_residual")),
     ("Hill stability", lambda f, n: "stability" in f),
 )
 
