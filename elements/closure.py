@@ -89,6 +89,66 @@ def _solve_small(K, R):
     return W[:, n:n + m].copy(), norm_k * norm_inv
 
 
+@nb.njit(cache=True)
+def _close_or_update(s, s_begin, ds, ds_begin, Ms, tol, passes, last_res, newton_ok, seeds_fixed):
+    """The closure rules (module doc) after a pass: closed, or ``s`` / ``ds`` updated in place.
+
+    ``s`` (ns,), ``ds`` (ns, P) at the end of the pass, ``s_begin``, ``ds_begin`` at its start,
+    ``Ms`` (ns, ns) the period map's derivative.  Returns ``(closed, last_res, newton_ok,
+    seeds_fixed)``.  Law-independent, so compiled once (not inlined into every law's march).
+    """
+    ns, P = ds.shape
+    scale = 0.0
+    res = 0.0
+    for i in range(ns):
+        scale = max(scale, abs(s[i]), abs(s_begin[i]))
+        res = max(res, abs(s[i] - s_begin[i]))
+    dscale = 0.0
+    dres = 0.0
+    for i in range(ns):
+        for c in range(P):
+            dscale = max(dscale, abs(ds[i, c]), abs(ds_begin[i, c]))
+            dres = max(dres, abs(ds[i, c] - ds_begin[i, c]))
+    state_closed = res <= tol * scale or scale == 0.0
+    seeds_closed = dres <= 1e3 * tol * dscale or dscale == 0.0
+    if state_closed and (seeds_closed or seeds_fixed):
+        return True, last_res, newton_ok, seeds_fixed
+    slow = passes >= 2 and res > 0.3 * last_res
+    if not state_closed:
+        if res >= last_res and passes > 2:
+            newton_ok = False
+        last_res = res
+        if not (slow and newton_ok):
+            return False, last_res, newton_ok, seeds_fixed
+    # (I - M) Y = R: R = ds - ds_begin (state closed, seeds not: the affine seed map solved once,
+    # then re-recorded), or R = [s - s_begin, ds - ds_begin] (Newton on state and seeds);
+    # explicit loops, not array expressions: they cost seconds of compile time
+    o = 0 if state_closed else 1
+    K = np.empty((ns, ns))
+    R = np.empty((ns, P + o))
+    for i in range(ns):
+        for k in range(ns):
+            K[i, k] = (1.0 if i == k else 0.0) - Ms[i, k]
+        if o == 1:
+            R[i, 0] = s[i] - s_begin[i]
+        for c in range(P):
+            R[i, o + c] = ds[i, c] - ds_begin[i, c]
+    Y, cond = _solve_small(K, R)
+    if state_closed:
+        if cond > 1e12:
+            return True, last_res, newton_ok, seeds_fixed
+        for i in range(ns):
+            for c in range(P):
+                ds[i, c] = ds_begin[i, c] + Y[i, c]
+        return False, last_res, newton_ok, True
+    if cond <= 1e12:
+        for i in range(ns):
+            s[i] = s_begin[i] + Y[i, 0]
+            for c in range(P):
+                ds[i, c] = ds_begin[i, c] + Y[i, 1 + c]
+    return False, last_res, newton_ok, seeds_fixed
+
+
 @nb.njit(inline="always")
 def newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     """Body of :func:`march_newton`, inlined into its callers.
@@ -117,7 +177,6 @@ def newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     last_res = np.inf
     newton_ok = True
     seeds_fixed = False
-    eye = np.eye(ns)
     while passes < max_passes and not closed:
         passes += 1
         for i in range(ns):
@@ -125,7 +184,9 @@ def newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
             for c in range(P):
                 ds_begin[i, c] = D[cur, i, c]
         mc = 0
-        MS[0, :, :] = eye
+        for i in range(ns):
+            for c in range(ns):
+                MS[0, i, c] = 1.0 if i == c else 0.0
         j = start
         for jj in range(N):
             j += 1
@@ -155,46 +216,8 @@ def newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
                 for a in range(n_local):
                     for c in range(P):
                         df[j, a, c] = D[cur, a, c]
-        Ms = MS[mc]
-        ds = D[cur]
-        scale = 0.0
-        res = 0.0
-        for i in range(ns):
-            scale = max(scale, abs(s[i]), abs(s_begin[i]))
-            res = max(res, abs(s[i] - s_begin[i]))
-        dscale = 0.0
-        dres = 0.0
-        for i in range(ns):
-            for c in range(P):
-                dscale = max(dscale, abs(ds[i, c]), abs(ds_begin[i, c]))
-                dres = max(dres, abs(ds[i, c] - ds_begin[i, c]))
-        state_closed = res <= tol * scale or scale == 0.0
-        seeds_closed = dres <= 1e3 * tol * dscale or dscale == 0.0
-        if state_closed and (seeds_closed or seeds_fixed):
-            closed = True
-            break
-        if state_closed:
-            Y, cond = _solve_small(eye - Ms, ds - ds_begin)
-            if cond > 1e12:
-                closed = True
-                break
-            # periodic state, non-periodic seeds: solve the affine seed map once, then re-record
-            ds[:, :] = ds_begin + Y
-            seeds_fixed = True
-            continue
-        slow = passes >= 2 and res > 0.3 * last_res
-        if res >= last_res and passes > 2:
-            newton_ok = False
-        last_res = res
-        if slow and newton_ok:
-            # state and seeds updated by one elimination: R = [s - s_begin, ds - ds_begin]
-            Rhs = np.empty((ns, P + 1))
-            Rhs[:, 0] = s - s_begin
-            Rhs[:, 1:] = ds - ds_begin
-            Y, cond = _solve_small(eye - Ms, Rhs)
-            if cond <= 1e12:
-                s[:] = s_begin + Y[:, 0]
-                ds[:, :] = ds_begin + Y[:, 1:]
+        closed, last_res, newton_ok, seeds_fixed = _close_or_update(
+            s, s_begin, D[cur], ds_begin, MS[mc], tol, passes, last_res, newton_ok, seeds_fixed)
     if not closed:
         passes = -passes
     return f, df, passes

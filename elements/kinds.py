@@ -2,7 +2,7 @@
 
 One id per law kernel; :func:`elements.kernels.law_step` switches on it.  Adding a law means
 adding an id here, its ``*_step`` / ``*_init`` kernels in its own module, and one branch in
-each of ``law_step`` and ``law_init``.
+each of ``_law_step`` and ``_law_init`` (elements.kernels).
 """
 JENKINS = 0
 CUBIC = 1

@@ -92,7 +92,7 @@ def coulomb_sk_init(p, z0, s0, C0):
     C0[1, 0] = 1.0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _regularised(p, v):
     """Force and its derivative with respect to the velocity."""
     F0 = p[0]

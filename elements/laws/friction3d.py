@@ -40,7 +40,7 @@ import math
 import numba as nb
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _radial_return(limit, t0, t1):
     """Return mapping of the trial force ``(t0, t1)`` (``t1 = 0`` for one direction) onto the
     circle of radius ``limit``: ``(f0, f1, r, d0, d1, slipping)`` with ``d = f^{tr}/|f^{tr}|``
@@ -55,7 +55,7 @@ def _radial_return(limit, t0, t1):
     return limit * d0, limit * d1, r, d0, d1, True
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, with_A):
     """Tangential forces into ``s_new`` and their derivatives (module doc) into ``A``
     (if ``with_A``: ``df_t/df_prev = J``, ``df_t/du_prev = -kt J``) and ``B``
@@ -78,7 +78,7 @@ def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A,
         B[a, nt] = mu * kn * da if slipping else 0.0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True)
 def _normal_and_slider(p, z, s_new, B):
     """Slider positions ``u_t,prev = u_t`` and the normal force into ``s_new`` with their
     derivatives in ``B`` (zeroed first); returns the normal load ``N`` (<= 0: open, then the
