@@ -36,7 +36,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .kernels import law_step_inline, rest_start, propagate
+from .kernels import rest_start, sample_step
 
 
 @nb.njit(cache=True)
@@ -192,13 +192,7 @@ def newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
             j += 1
             if j >= N:
                 j = 0
-            for k in range(nz):
-                zj[k] = z[j, k]
-            law_step_inline(kind, p, s, zj, s_new, A, B)
-            for i in range(ns):
-                s[i] = s_new[i]
-            for a in range(n_local):
-                f[j, a] = s[a]
+            cur = sample_step(kind, p, z, dz, j, zj, s, s_new, A, B, D, cur, f, df)
             # M <- A M (A is small and sparse)
             mn = 1 - mc
             for i in range(ns):
@@ -210,12 +204,6 @@ def newton_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
                         for c in range(ns):
                             MS[mn, i, c] += m * MS[mc, k, c]
             mc = mn
-            if P > 0:
-                propagate(A, B, D, cur, dz, j)
-                cur = 1 - cur
-                for a in range(n_local):
-                    for c in range(P):
-                        df[j, a, c] = D[cur, a, c]
         closed, last_res, newton_ok, seeds_fixed = _close_or_update(
             s, s_begin, D[cur], ds_begin, MS[mc], tol, passes, last_res, newton_ok, seeds_fixed)
     if not closed:

@@ -117,6 +117,31 @@ def propagate(A, B, D, cur, dz, j):
 
 
 @nb.njit(inline="always")
+def sample_step(kind, p, z, dz, j, zj, s, s_new, A, B, D, cur, f, df):
+    """Advance the state ``s`` (ns,) and the seed buffers ``D`` (2, ns, P) over sample ``j``
+    and record forces ``f[j]`` and seeds ``df[j]``; returns the seeds' new buffer index.
+    ``A``, ``B`` keep the step's local Jacobians (the Newton closure also uses ``A``);
+    ``zj``, ``s_new`` are work arrays."""
+    for k in range(zj.shape[0]):
+        zj[k] = z[j, k]
+    law_step_inline(kind, p, s, zj, s_new, A, B)
+    for i in range(s.shape[0]):
+        s[i] = s_new[i]
+    n_local = f.shape[1]
+    for a in range(n_local):
+        f[j, a] = s[a]
+    P = D.shape[2]
+    if P == 0:
+        return cur
+    propagate(A, B, D, cur, dz, j)
+    cur = 1 - cur
+    for a in range(n_local):
+        for c in range(P):
+            df[j, a, c] = D[cur, a, c]
+    return cur
+
+
+@nb.njit(inline="always")
 def rest_start(kind, p, z, dz, start, s, D, zj, B):
     """Rest state ``s`` at sample ``start`` and its seeds ``D[0] = C0 dz[start]``
     (``zj`` (nz,) and ``B`` (ns, nz) are work arrays; ``D`` (2, ns, P) is overwritten)."""
@@ -165,19 +190,7 @@ def march_body(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
             j += 1
             if j >= N:
                 j = 0
-            for k in range(nz):
-                zj[k] = z[j, k]
-            law_step_inline(kind, p, s, zj, s_new, A, B)
-            for i in range(ns):
-                s[i] = s_new[i]
-            for a in range(n_local):
-                f[j, a] = s[a]
-            if P > 0:
-                propagate(A, B, D, cur, dz, j)
-                cur = 1 - cur
-                for a in range(n_local):
-                    for c in range(P):
-                        df[j, a, c] = D[cur, a, c]
+            cur = sample_step(kind, p, z, dz, j, zj, s, s_new, A, B, D, cur, f, df)
         scale = 0.0
         diff = 0.0
         for i in range(ns):

@@ -22,6 +22,7 @@ that (to round-off), so the caller may skip marching and transforming.
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numba as nb
@@ -178,13 +179,8 @@ def make_law_march(kind, closure):
     return law_march
 
 
-_LAW_MARCHES = {}   # (kind, closure) -> compiled march: a memo of compiled code only
-
-
+@functools.cache
 def march_of(kind, closure):
-    """The march of law ``kind`` with closure ``closure`` (:func:`make_law_march`), built once."""
-    key = (int(kind), int(closure))
-    m = _LAW_MARCHES.get(key)
-    if m is None:
-        m = _LAW_MARCHES[key] = make_law_march(*key)
-    return m
+    """The march of law ``kind`` with closure ``closure`` (:func:`make_law_march`), built once
+    per process (the cache holds compiled code only)."""
+    return make_law_march(kind, closure)

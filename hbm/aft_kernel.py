@@ -27,6 +27,8 @@ sample.  The steps avoid BLAS/LAPACK bindings where loops do.
 """
 from __future__ import annotations
 
+import functools
+
 import numba as nb
 import numpy as np
 
@@ -231,17 +233,14 @@ def make_aft_law(kind, closure):
     return run
 
 
-_AFT_LAWS = {}      # (kind, closure) -> compiled run: a memo of compiled code only
 _NO_J4 = np.zeros((0, 0, 0, 0))
 
 
+@functools.cache
 def aft_of(kind, closure):
-    """:func:`make_aft_law` of ``(kind, closure)``, built once per process."""
-    key = (int(kind), int(closure))
-    run = _AFT_LAWS.get(key)
-    if run is None:
-        run = _AFT_LAWS[key] = make_aft_law(*key)
-    return run
+    """:func:`make_aft_law` of ``(kind, closure)``, built once per process (the cache holds
+    compiled code only)."""
+    return make_aft_law(kind, closure)
 
 
 def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
