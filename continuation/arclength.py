@@ -25,6 +25,15 @@ Bounds: when the predictor (or the corrected point) leaves :math:`[\lambda_{lo},
 \lambda_{hi}]`, the last point is solved with :math:`\lambda` fixed on the bound, starting
 from the chord's crossing of the bound, and the run ends with status ``'finished'``.
 
+Parameter-step limit (optional ``lam_step``): the caller may know where the path has
+features narrower than the step control can see from two end points, e.g. the linear
+resonances of a frequency response, which a step can jump over whole when the path is
+nearly straight on both sides of the peak.  ``lam_step(lam, direction)`` gives the largest
+parameter change :math:`\Delta\lambda_{max}` for a step from :math:`\lambda` moving in
+``direction`` (the sign of :math:`t_\lambda`); the step is then shortened to
+:math:`ds \le \Delta\lambda_{max} / (s_\lambda |t_\lambda|)`, i.e. the predictor moves the
+parameter by at most that much.
+
 Folds: a sign change of :math:`t_\lambda` between two accepted points marks a turning point,
 located by cubic Hermite interpolation of :math:`\lambda(s)`.
 
@@ -42,6 +51,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
+from .kernels import step_geometry
 from .options import ArclengthOptions
 from .point import ContinuationPoint
 from .tangent import fold_parameter, null_tangent
@@ -105,6 +115,10 @@ class Arclength:
         Sign of the parameter's motion along the first tangent.
     options : ArclengthOptions or None
         ``None`` uses the defaults.
+    lam_step : callable or None
+        ``lam_step(lam, direction) -> float``: the largest parameter change (unscaled, > 0)
+        of a step from ``lam`` whose parameter moves in ``direction`` (+1 or -1); ``None``:
+        no limit (module doc).
 
     Attributes
     ----------
@@ -126,7 +140,7 @@ class Arclength:
     """
 
     def __init__(self, fun: Fun, x0, scale=None, lam_bounds=(-np.inf, np.inf),
-                 direction: int = +1, options: ArclengthOptions | None = None):
+                 direction: int = +1, options: ArclengthOptions | None = None, lam_step=None):
         x0 = np.array(x0, dtype=float).ravel()
         if x0.size < 2 or not np.all(np.isfinite(x0)):
             raise ValueError("x0 must be a finite vector [y, lam] with at least one unknown")
@@ -148,6 +162,7 @@ class Arclength:
         self.lam_bounds = (lo, hi)
         self.direction = direction
         self.options = options if options is not None else ArclengthOptions()
+        self.lam_step = lam_step
         self.ds0, self.ds_min, self.ds_max = self.options.step_lengths((hi - lo) / scale[-1])
         self.status = "running"
         self.message = ""
@@ -164,12 +179,12 @@ class Arclength:
         self.n_eval += 1
         n = xs.size - 1
         R, J = self.fun(xs * self.scale)
-        R = np.asarray(R, dtype=float).reshape(-1)
-        J = np.asarray(J, dtype=float)
+        R = np.ascontiguousarray(R, dtype=float).reshape(-1)
+        J = np.ascontiguousarray(J, dtype=float)
         if R.shape != (n,) or J.shape != (n, n + 1):
             raise ValueError(f"fun must return R shape ({n},) and J shape ({n}, {n + 1}), "
                              f"got {R.shape} and {J.shape}")
-        return Evaluation(xs.copy(), R, J * self.scale)
+        return Evaluation.scaled(xs.copy(), R, J, self.scale)
 
     def _correct(self, xs0, constraint) -> Correction:
         o = self.options
@@ -242,6 +257,7 @@ class Arclength:
                 self.message = f"parameter reached the bound lam={xs[-1] * s_lam:.6g}"
                 return
 
+            ds = self._limited(xs, t, ds)
             c, t_new, angle, reason, on_bound = self._step(xs, t, ds, angle_reject, False)
             if reason is not None and consecutive >= 1 and not on_bound:
                 # repeated trouble at this point: maybe a sharp corner of the path, which a
@@ -298,6 +314,17 @@ class Arclength:
             ds = min(max(ds * factor, self.ds_min), self.ds_max)
             consecutive = 0
 
+    def _limited(self, xs, t, ds):
+        """``ds`` shortened so that the predictor moves the parameter by at most
+        ``lam_step`` (module doc), never below ``ds_min``."""
+        if self.lam_step is None or t[-1] == 0.0:
+            return ds
+        s_lam = self.scale[-1]
+        cap = float(self.lam_step(xs[-1] * s_lam, 1 if t[-1] > 0 else -1))
+        if not cap > 0:
+            return self.ds_min
+        return max(min(ds, cap / (s_lam * abs(t[-1]))), self.ds_min)
+
     def _step(self, xs, t, ds, angle_reject, sphere):
         """Predict and correct one step; return ``(c, t_new, angle, reason, on_bound)``.
 
@@ -329,9 +356,10 @@ class Arclength:
                 on_bound = True
         if not c.converged:
             return c, None, 0.0, f"Newton did not converge ({c.reason})", on_bound
-        chord = c.xs - xs
-        chord_len = _norm(chord)
-        along = float(chord @ t)
+        # the hyperplane's a is t: the corrector's null vector solves the tangent system
+        # (finite, and t @ null = 1, so not zero)
+        fast = c.null is not None and not sphere and not on_bound
+        chord_len, along, jump, cosang, f = step_geometry(xs, t, c.xs, start, c.null if fast else t)
         if not chord_len > 0:
             return c, None, 0.0, "the corrector returned to the last point", on_bound
         if sphere:
@@ -339,18 +367,16 @@ class Arclength:
                 return c, None, 0.0, "the corrector went back along the path", on_bound
         elif along <= 0:
             return c, None, 0.0, "the corrector went back along the path", on_bound
-        jump = _norm(c.xs - start)
         if not sphere and not on_bound and jump > o.max_correction * ds:
             return (c, None, 0.0,
                     f"the corrector moved {jump / ds:.2g} step lengths (branch jump)", on_bound)
-        if c.null is not None and not sphere and not on_bound:
-            # the hyperplane's a is t: same system (finite, and t @ null = 1, so not zero)
-            t_new = c.null / _norm(c.null)
+        if fast:
+            t_new = c.null * f
         else:
-            t_new = null_tangent(c.ev.Js, t)
-        if t_new @ chord < 0:
-            t_new = -t_new
-        cosang = min(1.0, max(-1.0, float(t_new @ t)))
+            u = null_tangent(c.ev.Js, t)
+            _, _, _, cosang, f = step_geometry(xs, t, c.xs, start, u)
+            t_new = u * f
+        cosang = min(1.0, max(-1.0, cosang))
         angle = math.acos(cosang)
         if cosang <= (-math.cos(max_angle) if sphere else 0.0):
             return c, t_new, angle, "the tangent reversed", on_bound

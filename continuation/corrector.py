@@ -54,6 +54,8 @@ from typing import Callable
 import numpy as np
 from scipy.linalg.lapack import dgesv
 
+from .kernels import bordered_system, inf_norm, scale_jacobian
+
 _EPS = np.finfo(float).eps
 
 
@@ -65,7 +67,6 @@ def solve(A: np.ndarray, B: np.ndarray):
     return x if info == 0 else None
 
 
-@dataclass
 class Evaluation:
     """The caller's function at one scaled point.
 
@@ -77,21 +78,40 @@ class Evaluation:
         Residual.
     Js : ndarray, shape (n, n+1)
         Scaled Jacobian ``J * scale``.
+
+    Attributes
+    ----------
+    r_max : float
+        ``||R||_inf``.
+    x_max : float
+        ``||xs||_inf``.
     """
 
-    xs: np.ndarray
-    R: np.ndarray
-    Js: np.ndarray
+    __slots__ = ("xs", "R", "Js", "r_max", "x_max", "_row_norm", "_finite")
 
-    def __post_init__(self):
-        # one pass over Js gives both: a NaN or inf entry makes its row sum and the
-        # maximum NaN or inf (so does an overflowing sum, which is no usable Jacobian either)
-        norm = float(np.abs(self.Js).sum(axis=1).max(initial=0.0))
-        R = self.R
-        r_max = max(float(R.max()), -float(R.min())) if R.size else 0.0
-        self._finite = math.isfinite(norm) and math.isfinite(r_max)
-        self._row_norm = norm if self._finite else 0.0
-        self.r_max = r_max      # ||R||_inf
+    def __init__(self, xs: np.ndarray, R: np.ndarray, Js: np.ndarray):
+        Js = np.ascontiguousarray(Js, dtype=float)
+        R = np.ascontiguousarray(R, dtype=float)
+        self._set(xs, R, Js, scale_jacobian(R, Js, np.ones(Js.shape[1]), np.empty_like(Js)))
+
+    @classmethod
+    def scaled(cls, xs: np.ndarray, R: np.ndarray, J: np.ndarray, scale: np.ndarray) -> "Evaluation":
+        """From the unscaled Jacobian ``J`` (n, n+1): ``Js = J * scale`` and the norms in one
+        compiled pass (:func:`continuation.kernels.scale_jacobian`)."""
+        ev = cls.__new__(cls)
+        Js = np.empty(J.shape)
+        ev._set(xs, R, Js, scale_jacobian(R, J, scale, Js))
+        return ev
+
+    def _set(self, xs, R, Js, stats):
+        norm, r_max, finite = stats
+        self.xs = xs
+        self.R = R
+        self.Js = Js
+        self._finite = finite
+        self._row_norm = norm if finite else 0.0
+        self.r_max = r_max
+        self.x_max = inf_norm(xs)
 
     @property
     def finite(self) -> bool:
@@ -200,8 +220,8 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     if rho0 is None:
         rho0 = 1e-300
     n = ev.R.size
-    rhs = np.empty(n + 1)
     A = np.empty((n + 1, n + 1), order="F")     # refilled before every solve
+    B1 = np.empty((n + 1, 1), order="F")
     best = (np.inf, ev, 0)
     sqrt_tol = math.sqrt(tol)
     backtrack_below = max(1e3 * tol, sqrt_tol)
@@ -211,8 +231,7 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         rho = max(rho0, ev.row_norm())
         res = ev.r_max / rho
         g, a = constraint(ev.xs)
-        xs = ev.xs
-        size = 1.0 + max(float(xs.max()), -float(xs.min()))
+        size = 1.0 + ev.x_max
         converged = res <= tol and abs(g) <= tol * size
         if res < best[0] and abs(g) <= tol * size:
             best = (res, ev, it)
@@ -223,30 +242,24 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             break
         if it == max_iter and not converged:
             break
-        A[:n] = ev.Js
-        A[n] = rho * a
-        np.negative(ev.R, out=rhs[:n])
-        rhs[n] = -rho * g
-        null = None
-        if converged:
-            # the same matrix also gives the null vector of Js (the tangent, module doc)
-            B = np.zeros((n + 1, 2), order="F")
-            B[:, 0] = rhs
-            B[n, 1] = rho
-            sol = solve(A, B)
-            delta, null = (None, None) if sol is None else (sol[:, 0], sol[:, 1])
-            if null is not None and not math.isfinite(float(null.sum())):
-                null = None
-        else:
-            delta = solve(A, rhs)
-        if delta is None or not math.isfinite(float(delta.sum())):
+        # when converged, the same matrix also gives the null vector of Js (the tangent,
+        # module doc) from a second right-hand side
+        B = np.empty((n + 1, 2), order="F") if converged else B1
+        bordered_system(ev.Js, ev.R, a, rho, g, A, B)
+        sol = solve(A, B)
+        d_max = math.nan if sol is None else inf_norm(sol[:, 0])
+        if not math.isfinite(d_max):
             if converged:
                 return Correction(True, ev, it, res)
             return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
+        delta = sol[:, 0]
         if converged:
+            null = sol[:, 1]
+            if not math.isfinite(inf_norm(null)):
+                null = None
             # free polishing update: error ~ |delta|^2, no further call of the function
             return Correction(True, ev, it, res, xs=ev.xs + delta, null=null)
-        if res <= sqrt_tol and np.abs(delta).max() <= 16 * _EPS * size:
+        if res <= sqrt_tol and d_max <= 16 * _EPS * size:
             return Correction(True, ev, it, res)
         merit = max(res, abs(g))
         theta = 1.0
