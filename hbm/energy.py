@@ -48,10 +48,13 @@ def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
     if own is not None:
         return own(X, w)
     basis = problem.basis
+    s = 1 if basis.has_zero else 0          # the mean does no work
     V = w * (basis.D @ X)
-    w_ex = work(basis, problem.Fex, V, w)
+    Vp = V[s:]
+    half_T = np.pi / w
+    w_ex = half_T * float(np.vdot(problem.Fex[s:], Vp))
     if problem.fixed.size:
         w_ex += work(basis, problem.support_reactions(X, w), V[:, problem.fixed], w)
-    w_visc = work(basis, V @ problem.model.C, V, w)
-    w_nl = work(basis, problem.nonlinear_forces(X, w), V, w)
+    w_visc = half_T * float(np.vdot(Vp @ problem.model.C, Vp))
+    w_nl = half_T * float(np.vdot(problem.nonlinear_forces(X, w)[s:], Vp))
     return EnergyBalance(w_ex, w_visc, w_nl)

@@ -247,6 +247,8 @@ class HarmonicBalance:
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
         """``F_nl`` on all DOFs, (n_coef, n)."""
+        if self._nl_all:
+            return self.nl.forces(X, w)
         F = np.zeros_like(X)
         if self.nl.n_nl:
             F[:, self.nl.dofs] = self.nl.forces(np.ascontiguousarray(X[:, self.nl.dofs]), w)

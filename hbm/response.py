@@ -27,6 +27,7 @@ from .jumps import predict_jumps
 from .newton import newton
 from .reduction_cache import cache_path, reduce_cached
 from .residual import HarmonicBalance
+from .resonances import ResonanceStepLimit, linear_resonances
 from .stability import StabilityOptions, point_is_stable
 from .structure import AUTO_CONDENSE_DOF
 from .transforms import make_transform
@@ -338,7 +339,20 @@ class _Path:
             getattr(self, name).extend(getattr(other, name)[::-1])
 
 
-def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, opts, progress, offset=0):
+def _step_limit(problem, case, window) -> ResonanceStepLimit:
+    """The FRF's parameter-step limit at the linear resonances of the free and stuck limits
+    (:mod:`hbm.resonances`) inside ``window`` (rad/s)."""
+    Ks = _stuck_stiffness(problem)
+    if isinstance(problem, CondensedHarmonicBalance):
+        om, z = linear_resonances(problem, Ks=Ks)
+    else:
+        m = problem.model
+        om, z = linear_resonances(problem, m.M, m.C, m.K, Ks, _stuck_damping(problem))
+    return ResonanceStepLimit(om, z, window)
+
+
+def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, opts, progress, offset=0,
+           lam_step=None):
     """One continuation from ``(X0, w0)`` in ``direction``; appends to ``pts``.
 
     Returns ``(status, message, folds_hz, n_rejected)``.  Points whose energy balance is
@@ -347,7 +361,7 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     """
     scale = np.r_[xscale, bounds[1] - bounds[0]]
     solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
-                       direction=direction, options=opts)
+                       direction=direction, options=opts, lam_step=lam_step)
     for pt in solver:
         X = problem.expand(pt.x[:-1])
         w = float(pt.x[-1])
@@ -423,7 +437,9 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         message = str(exc)
     else:
         opts = options or ArclengthOptions()
-        seg = _trace(problem, case, pts, X0, it0, w_lo, (w_lo, w_hi), +1, xscale, r_scale, opts, progress)
+        lam_step = _step_limit(problem, case, (w_lo, w_hi))
+        seg = _trace(problem, case, pts, X0, it0, w_lo, (w_lo, w_hi), +1, xscale, r_scale, opts, progress,
+                     lam_step=lam_step)
         status, message, folds, n_rej = seg
         segments.append([0, len(pts.w)])
         if status == "finished" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9):
@@ -438,7 +454,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
                 status, message = "failed", f"{first_msg}, but: {exc}"
             else:
                 st2, msg2, f2, r2 = _trace(problem, case, part, Xh, ith, w_hi, (w_lo, w_hi), -1, xscale,
-                                           r_scale, opts, progress, offset=len(pts.w))
+                                           r_scale, opts, progress, offset=len(pts.w), lam_step=lam_step)
                 folds, n_rej = folds + f2, n_rej + r2
                 if st2 == "finished" and part.w and part.w[-1] > w_lo * (1 + 1e-9):
                     st2 = "failed"

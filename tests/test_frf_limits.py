@@ -45,3 +45,43 @@ def test_energy_balance_every_point_sdof_and_3dof():
     assert np.all(res.energy_error < 1e-8), res.energy_error.max()
     # friction dissipates: the response is below the undamped-by-friction free linear peak
     assert res.outputs["a"].h1.max() < 50
+
+
+def test_linear_resonances_of_both_limits_and_the_step_limit():
+    from hbm.resonances import ResonanceStepLimit, linear_resonances
+    from hbm.response import _step_limit, build_problem
+    from hbm.fourier import FourierBasis
+    case = sdof_jenkins_case(m=1.0, k=4e4, c=2.0, kt=2.667e4, fs=2.0, f_hz=(20, 50), H=3, N=32)
+    problem, _ = build_problem(case, FourierBasis([1, 2, 3], 32), "auto")
+    lim = _step_limit(problem, case, (2 * np.pi * 20, 2 * np.pi * 50))
+    w0, ws = np.sqrt(4e4), np.sqrt(4e4 + 2.667e4)
+    assert np.allclose(sorted(lim.omega), [w0, ws], rtol=1e-12)
+    assert np.allclose(sorted(lim.width), [1.0, 1.0], rtol=1e-12)   # zeta w = c / (2 m)
+    # ahead: at most 0.7 of the distance; inside the band: half its half-width; behind: free
+    assert lim(w0 - 10.0, +1) == pytest.approx(7.0)
+    assert lim(w0 + 0.5, +1) == pytest.approx(0.5)
+    assert lim(w0 + 2.0, +1) == pytest.approx(0.7 * (ws - w0 - 2.0))
+    assert lim(w0 + 0.5, -1) == pytest.approx(0.5)
+    assert lim(ws + 5.0, +1) == np.inf
+    # resonances outside the path's window are left out
+    assert _step_limit(problem, case, (w0 + 2.0, 400.0)).omega.tolist() == [ws]
+    # undamped modes get the floor width, not zero (no endless approach)
+    assert ResonanceStepLimit([10.0], [0.0])(10.0, 1) == pytest.approx(0.5 * 1e-4 * 10.0)
+    om, z = linear_resonances(problem, case.model.M, case.model.C, case.model.K,
+                              np.zeros((1, 1)), np.zeros((1, 1)))
+    assert np.allclose(om, [w0, w0]) and np.allclose(z, 1.0 / w0)
+
+
+@pytest.mark.parametrize("tol", [1e-8, 1e-9, 1e-10])
+def test_a_stuck_resonance_is_not_stepped_over(tol):
+    """A contact that never slips leaves a linear peak 0.3 Hz wide in a 30 Hz window, and every
+    step converges at once and grows.  Without the resonance step limit, tol = 1e-9 lands one
+    step on the far side of the peak (10 points, peak amplitude 4 % of the true one)."""
+    from continuation import ArclengthOptions
+    case = sdof_jenkins_case(m=1.0, k=4e4, c=2.0, kt=2.667e4, fs=300.0, F=5.0, f_hz=(20, 50), H=3, N=32)
+    res = hbm.frf(case, stability=False, options=ArclengthOptions(tol=tol))
+    assert res.ok, res.message
+    ws = np.sqrt(4e4 + 2.667e4)
+    i = np.argmax(res.outputs["x"].h1)
+    assert res.outputs["x"].h1[i] == pytest.approx(5.0 / (2.0 * ws), rel=0.03)
+    assert res.freq_hz[i] == pytest.approx(ws / (2 * np.pi), rel=2e-3)
