@@ -15,7 +15,9 @@ then the new tangent :math:`t_{k+1}` spans the null space of :math:`J_s(x_{k+1})
 (:mod:`continuation.tangent`) with the sign of the chord,
 :math:`t_{k+1}^T (x_{s,k+1} - x_{s,k}) > 0`.  A step is rejected (``ds`` halved) when Newton
 fails, the chord points backwards (:math:`t_k^T (x_{s,k+1} - x_{s,k}) \le 0`), the
-correction exceeds ``max_correction * ds``, or the tangents turn by more than
+correction exceeds ``max_correction * ds``, the parameter moves against the sign of
+:math:`t_\lambda` at both ends (no fold lies between, so the corrector found another part of
+the path), or the tangents turn by more than
 ``max_angle_deg``; a turn that does not shrink when ``ds`` is halved is a kink of the path
 (non-smooth Jacobian) and is accepted, so is any turn below 90 degrees once ``ds`` cannot be
 halved without going under ``ds_min``.  Accepted steps adapt ``ds`` as in
@@ -377,6 +379,13 @@ class Arclength:
             _, _, _, cosang, f = step_geometry(xs, t, c.xs, start, u)
             t_new = u * f
         cosang = min(1.0, max(-1.0, cosang))
+        dlam = c.xs[-1] - xs[-1]
+        if (not on_bound and t[-1] * t_new[-1] > 0 and dlam * t[-1] < 0
+                and abs(dlam) > 1e-3 * ds * abs(t[-1])):
+            # the parameter moved against both end tangents: no fold can lie between, so the
+            # corrector landed on another part of the path (one that passes close by, e.g.
+            # the start of a resonance loop seen from its end)
+            return c, None, 0.0, "the parameter went back without a fold (branch jump)", on_bound
         angle = math.acos(cosang)
         if cosang <= (-math.cos(max_angle) if sphere else 0.0):
             return c, t_new, angle, "the tangent reversed", on_bound

@@ -85,3 +85,20 @@ def test_a_stuck_resonance_is_not_stepped_over(tol):
     i = np.argmax(res.outputs["x"].h1)
     assert res.outputs["x"].h1[i] == pytest.approx(5.0 / (2.0 * ws), rel=0.03)
     assert res.freq_hz[i] == pytest.approx(ws / (2 * np.pi), rel=2e-3)
+
+
+def test_a_needle_resonance_is_passed_once():
+    """A stuck contact 1e4 times stiffer than the structure: its resonance is a circle in the
+    (cos, sin) plane over a ten-thousandth of the window.  Seen from the end of the circle, the
+    start of it lies one step away; the corrector landed there and the path went round the
+    circle 30 times (1062 points) until a rule rejected steps whose parameter moves against
+    the tangents at both ends."""
+    case = sdof_jenkins_case(m=1.0, k=1.0, c=0.02, kt=1e4, fs=0.01, F=1e-7, f_hz=(0.5 / (2 * np.pi), 150.0 / (2 * np.pi)),
+                             H=5, N=64)
+    res = hbm.frf(case, stability=False)
+    assert res.ok, res.message
+    w = 2 * np.pi * res.freq_hz
+    assert np.all(np.diff(w) > 0)                     # linear: one pass, no reversal
+    assert res.freq_hz.size < 150
+    ws = np.sqrt(1.0 + 1e4)
+    assert res.outputs["x"].h1.max() == pytest.approx(1e-7 / (0.02 * ws), rel=0.03)

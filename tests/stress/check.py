@@ -18,6 +18,11 @@ passive elements, whose work per period is >= 0):
   contact force inside its limit at every frequency of the path, that linear response *is*
   the solution: the first harmonic must equal it and the other harmonics must vanish.
 
+* stuck peaks: when that also holds at the resonances of the stuck system inside the
+  window (where the stuck response peaks), the path must pass them: its largest
+  first-harmonic amplitude is at least ``PEAK_FRACTION`` of the stuck response's there (a
+  path that steps over a narrow peak samples only its foot).
+
 Anything else (NaN, energy not closed, an exception instead of a result, a bound violated)
 is ``bad``.
 """
@@ -29,6 +34,17 @@ from hbm.case import case_from_dict
 from hbm.response import frf
 
 ENERGY_TOL = 1e-8
+PEAK_FRACTION = 0.9
+
+
+def _stuck_resonances(case, w_lo, w_hi):
+    """Natural angular frequencies of the all-stuck linear system inside ``[w_lo, w_hi]``."""
+    K = case.model.K.copy()
+    for e in case.elements:
+        K = K + e.gather.T @ e.linear_stiffness() @ e.gather
+    lam = np.linalg.eigvals(np.linalg.solve(case.model.M, K)).real
+    w = np.sqrt(lam[lam > 0])
+    return w[(w >= w_lo) & (w <= w_hi)]
 
 
 def _stuck_linear(case, w):
@@ -113,6 +129,12 @@ def assess(data: dict, **frf_kwargs) -> dict:
             if err1 > 1e-7 or err_h > 1e-7:
                 problems.append(f"stuck limit: first harmonic off by {err1:.2e}, other harmonics {err_h:.2e} "
                                 f"(relative)")
+            wr = _stuck_resonances(case, 2 * np.pi * lo, 2 * np.pi * hi)
+            peaks = [_stuck_linear(case, x) for x in wr]
+            if peaks and all(_stays_stuck(case, x) for x in peaks):
+                top = max(float(np.linalg.norm(x)) for x in peaks)
+                if not X1.max() >= PEAK_FRACTION * top:
+                    problems.append(f"stuck peak |X1| = {top:.4g} missed: the path's largest is {X1.max():.4g}")
     if problems:
         return {**rec, "verdict": "bad", "detail": "; ".join(problems) + f" [status {res.status}: {res.message}]"}
     if res.ok:
