@@ -51,10 +51,10 @@ def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
     s = 1 if basis.has_zero else 0          # the mean does no work
     V = w * (basis.D @ X)
     Vp = V[s:]
-    half_T = np.pi / w
-    w_ex = half_T * float(np.vdot(problem.Fex[s:], Vp))
+
+    def on_v(F):                            # work() on the velocities of every DOF
+        return float(np.pi / w * np.vdot(F[s:], Vp))
+    w_ex = on_v(problem.Fex)
     if problem.fixed.size:
         w_ex += work(basis, problem.support_reactions(X, w), V[:, problem.fixed], w)
-    w_visc = half_T * float(np.vdot(Vp @ problem.model.C, Vp))
-    w_nl = half_T * float(np.vdot(problem.nonlinear_forces(X, w)[s:], Vp))
-    return EnergyBalance(w_ex, w_visc, w_nl)
+    return EnergyBalance(w_ex, on_v(V @ problem.model.C), on_v(problem.nonlinear_forces(X, w)))

@@ -37,22 +37,24 @@ ENERGY_TOL = 1e-8
 PEAK_FRACTION = 0.9
 
 
-def _stuck_resonances(case, w_lo, w_hi):
-    """Natural angular frequencies of the all-stuck linear system inside ``[w_lo, w_hi]``."""
+def _stuck_stiffness(case):
+    """Stiffness of the structure with every contact stuck, (n, n)."""
     K = case.model.K.copy()
     for e in case.elements:
         K = K + e.gather.T @ e.linear_stiffness() @ e.gather
-    lam = np.linalg.eigvals(np.linalg.solve(case.model.M, K)).real
+    return K
+
+
+def _stuck_resonances(case, w_lo, w_hi):
+    """Natural angular frequencies of the all-stuck linear system inside ``[w_lo, w_hi]``."""
+    lam = np.linalg.eigvals(np.linalg.solve(case.model.M, _stuck_stiffness(case))).real
     w = np.sqrt(lam[lam > 0])
     return w[(w >= w_lo) & (w <= w_hi)]
 
 
 def _stuck_linear(case, w):
     """First-harmonic response (complex, (n,)) of the all-stuck linear system at ``w``."""
-    K = case.model.K.copy()
-    for e in case.elements:
-        K = K + e.gather.T @ e.linear_stiffness() @ e.gather
-    Z = K - w * w * case.model.M + 1j * w * case.model.C
+    Z = _stuck_stiffness(case) - w * w * case.model.M + 1j * w * case.model.C
     return np.linalg.solve(Z, case.excitation.force)
 
 
