@@ -46,6 +46,7 @@ import numpy as np
 from .aft import NonlinearForces
 from .energy import EnergyBalance
 from .fourier import FourierBasis
+from .condensed_hill import modal_hill_system
 from .condensed_kernels import assemble, condensed_linear, modal_receptances, proportional_linear
 from .reduction import ReducedModel, condense, receptance_stack
 
@@ -373,6 +374,29 @@ class CondensedHarmonicBalance:
         F = np.zeros_like(X, dtype=float)
         F[:, d] = Fn
         return F
+
+    def nonlinear_jacobian(self, X: np.ndarray, w: float):
+        """``dF_nl/dU`` on every contact coordinate, (n_u, n_u), or ``None`` without elements."""
+        if not self.nl.n_nl:
+            return None
+        d = self.nl.dofs
+        _, dFn, _ = self.nl.evaluate(np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float), w)
+        if self._nl_all:
+            return dFn
+        Ja = np.zeros((self.n_unknowns, self.n_unknowns))
+        Ja[self._nl_ix] = dFn
+        return Ja
+
+    def contact_modes(self):
+        """Kept mode shapes ``Phi_c`` (n_c, m) and residual flexibility ``R_cc`` (n_c, n_c) on
+        the contact coordinates."""
+        c = self._sl["c"]
+        return self._phi["c"], self._R_all[c, c]
+
+    def hill_system(self, X: np.ndarray, w: float):
+        """Jacobian, mass and damping of Hill's problem at a point (:mod:`hbm.condensed_hill`):
+        on the kept modal coordinates, ``(n_coef m, n_coef m)``, ``(m, m)``, ``(m, m)``."""
+        return modal_hill_system(self, X, w)
 
     def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
         """Solution of ``(Z_c(w) + K_extra) U = F_eq(w)`` (n_coef, n_c): the start of Newton.

@@ -17,7 +17,10 @@ that bracket :math:`f_{jump}` unless a ``refine`` callable solves it there exact
 continuation's steps are long on flat branches, where linear interpolation is poor).
 The amplitude before the jump is that of the last stable point.  A downward sweep mirrors this.  A jump with no stable
 landing piece (e.g. a loss of stability without a fold) ends the sweep with
-``amplitude_after = None``.
+``amplitude_after = None``.  A landing within ``min_size`` (relative) of the amplitude before
+is no jump: the sweep goes on along the landing piece without recording one (a few points
+flagged unstable inside a branch that does not fold, such as a stability verdict that
+flickers at a stick-slip transition, leave the response where it was).
 """
 from __future__ import annotations
 
@@ -96,7 +99,7 @@ def _jump_frequency(freq, i_end, f_end, folds, direction, tol):
     return f_end if best is None else best
 
 
-def _sweep(freq, amp, stable, folds, direction, tol, refine):
+def _sweep(freq, amp, stable, folds, direction, tol, refine, min_size):
     pieces = stable_pieces(freq, stable)
     if not pieces:
         return []
@@ -131,12 +134,15 @@ def _sweep(freq, amp, stable, folds, direction, tol, refine):
         if refine is not None:
             exact = refine(*_bracket(freq, *pieces[m], f_jump), f_jump)
             after = after if exact is None else float(exact)
-        jumps.append({"from_hz": f_jump, "amplitude_before": before, "amplitude_after": after})
         k = m
+        if abs(after - before) <= min_size * max(abs(after), abs(before)):
+            continue                        # no change of amplitude: not a jump
+        jumps.append({"from_hz": f_jump, "amplitude_before": before, "amplitude_after": after})
     return jumps
 
 
-def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9, refine=None) -> dict:
+def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9, refine=None,
+                  min_size: float = 0.01) -> dict:
     """Jumps of slow upward and downward sweeps (module doc).
 
     Parameters
@@ -153,6 +159,9 @@ def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9
     refine : callable, optional
         ``refine(i0, i1, f_hz) -> amplitude or None``: the amplitude at ``f_hz`` on the path
         between points ``i0`` and ``i1`` solved exactly (``None``: keep the interpolation).
+    min_size : float
+        A landing whose amplitude differs from the one before by at most ``min_size`` times
+        the larger of the two is not a jump (module doc).
 
     Returns
     -------
@@ -170,4 +179,5 @@ def predict_jumps(freq_hz, amplitude, stable, folds_hz=(), rel_tol: float = 1e-9
         return {"up": [], "down": []}
     tol = rel_tol * max(float(f.max() - f.min()), 1e-300)
     folds = [float(x) for x in folds_hz]
-    return {"up": _sweep(f, amp, s, folds, +1, tol, refine), "down": _sweep(f, amp, s, folds, -1, tol, refine)}
+    return {"up": _sweep(f, amp, s, folds, +1, tol, refine, min_size),
+            "down": _sweep(f, amp, s, folds, -1, tol, refine, min_size)}

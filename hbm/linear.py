@@ -186,3 +186,36 @@ def harmonic_blocks(model: LinearModel, basis: FourierBasis, w: float):
         dB = h * C
         dblocks.append(np.block([[dA, dB], [-dB, dA]]))
     return blocks, dblocks
+
+
+def fill_dynamic_stiffness(Z: np.ndarray, K, C, M, basis: FourierBasis, w: float) -> np.ndarray:
+    r"""Write the dense harmonic-balance dynamic stiffness ``Z(w)`` into ``Z`` and return it.
+
+    Per coefficient row ``r`` of harmonic ``h_r``: ``K - (h_r w)^2 M`` on the diagonal block and
+    ``\pm h w C`` between the cosine and sine rows of ``h`` (the derivative operator), so that
+    ``(Z X)_r = K X_r + w C (D X)_r - w^2 h_r^2 M X_r``.
+
+    Parameters
+    ----------
+    Z : ndarray, shape (n_coef n, n_coef n)
+        Zeroed on entry (or holding only entries outside the blocks written here).
+    K, C, M : ndarray, shape (n, n)
+    basis : FourierBasis
+    w : float
+
+    Returns
+    -------
+    Z : ndarray, shape (n_coef n, n_coef n)
+        The same array, filled block by block through a 4-D view (no loop over harmonics).
+    """
+    nc, n = basis.n_coef, K.shape[0]
+    h = basis.h_of_row
+    Z4 = Z.reshape(nc, n, nc, n)
+    r = np.arange(nc)
+    Z4[r, :, r, :] = K[None] - (w * w) * (h * h).astype(float)[:, None, None] * M[None]
+    rc = np.flatnonzero(h > 0)[::2]
+    if rc.size:
+        wC = (w * h[rc]).astype(float)[:, None, None] * C[None]
+        Z4[rc, :, rc + 1, :] = wC
+        Z4[rc + 1, :, rc, :] = -wC
+    return Z

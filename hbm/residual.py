@@ -23,7 +23,7 @@ import numpy as np
 from .aft import NonlinearForces
 from .dense_kernels import dense_residual
 from .fourier import FourierBasis
-from .linear import LinearModel, harmonic_blocks
+from .linear import LinearModel, fill_dynamic_stiffness, harmonic_blocks
 
 
 class HarmonicBalance:
@@ -77,40 +77,20 @@ class HarmonicBalance:
         idx = (np.arange(basis.n_coef)[:, None] * n + self.nl.dofs[None, :]).ravel()
         self._nl_index = idx
         h = basis.h_of_row
-        self._rows = np.arange(h.size)
         self._h2 = (h * h).astype(float)
-        self._rows_c = np.array([r for r in range(h.size) if h[r] > 0 and (r == 0 or h[r - 1] != h[r])],
-                                dtype=np.int64)
-        self._rows_s = self._rows_c + 1
-        self._h_c = h[self._rows_c].astype(float)
         # small dense models: Z(w) = Z0 + w Z1 - w^2 Z2 from three matrices built once
         self._templates = None
         mats = (model.K, model.C, model.M)
         if basis.n_coef * n <= self.TEMPLATE_MAX and all(isinstance(m, np.ndarray) for m in mats):
-            self._templates = tuple(self._block_matrix(*parts) for parts in
-                                    ((model.K, None, None), (None, model.C, None), (None, None, model.M)))
+            nu_all, zero = basis.n_coef * n, np.zeros((n, n))
+            parts = ((model.K, zero, zero), (zero, model.C, zero), (zero, zero, -model.M))
+            self._templates = tuple(fill_dynamic_stiffness(np.zeros((nu_all, nu_all)), K, C, M, basis, 1.0)
+                                    for K, C, M in parts)
         self._fex_flat = np.ascontiguousarray(self.Fex.reshape(-1))
         nu_all = basis.n_coef * n
         self._zero_forces = (np.zeros(nu_all), np.zeros((nu_all, nu_all)), np.zeros(nu_all))
 
     TEMPLATE_MAX = 600     # largest n_coef * n_dof for which Z0, Z1, Z2 are kept (3 n^2 floats)
-
-    def _block_matrix(self, K, C, M):
-        """Dense ``Z`` of one part (n_coef n, n_coef n): ``K`` per row, ``h C`` in the cosine-sine
-        blocks (``-h C`` sine-cosine), ``h^2 M`` per row; the others None."""
-        nc, n = self.basis.n_coef, self.n_dof
-        Z = np.zeros((nc * n, nc * n))
-        Z4 = Z.reshape(nc, n, nc, n)
-        r = self._rows
-        if K is not None:
-            Z4[r, :, r, :] = K[None]
-        if M is not None:
-            Z4[r, :, r, :] = self._h2[:, None, None] * M[None]
-        if C is not None and self._rows_c.size:
-            hC = self._h_c[:, None, None] * C[None]
-            Z4[self._rows_c, :, self._rows_s, :] = hC
-            Z4[self._rows_s, :, self._rows_c, :] = -hC
-        return Z
 
     @property
     def n_unknowns(self) -> int:
@@ -156,15 +136,7 @@ class HarmonicBalance:
         ZX = X @ K + w * (DX @ C) - (w * w) * (h2X @ M)
         dZX = DX @ C - (2.0 * w) * (h2X @ M)
         nc, n = X.shape
-        Z = np.zeros((nc * n, nc * n)) if out is None else out
-        Z4 = Z.reshape(nc, n, nc, n)
-        r = self._rows
-        Z4[r, :, r, :] = K[None] - (w * w) * self._h2[:, None, None] * M[None]
-        rc, rs, hc = self._rows_c, self._rows_s, self._h_c
-        if rc.size:
-            wC = (w * hc)[:, None, None] * C[None]
-            Z4[rc, :, rs, :] = wC
-            Z4[rs, :, rc, :] = -wC
+        Z = fill_dynamic_stiffness(np.zeros((nc * n, nc * n)) if out is None else out, K, C, M, self.basis, w)
         return ZX, Z, dZX
 
     def residual(self, X: np.ndarray, w: float):
@@ -244,6 +216,13 @@ class HarmonicBalance:
         dense_residual(Z0, Z1, Z2, w, np.ascontiguousarray(x[:-1]), self._fex_flat, F.reshape(-1),
                        dF, dFw.reshape(-1), A[:, :nu], R, A[:, nu])
         return R, A
+
+    def hill_system(self, X: np.ndarray, w: float):
+        """Jacobian ``dR/dX`` (n_u, n_u), mass and damping (n_free, n_free) of Hill's problem
+        (:mod:`hbm.stability`) at a point; supports with imposed motion are not perturbed."""
+        _, J, _ = self.residual(X, w)
+        fr = np.ix_(self.free, self.free)
+        return J, self.model.M[fr], self.model.C[fr]
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
         """``F_nl`` on all DOFs, (n_coef, n)."""

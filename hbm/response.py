@@ -418,8 +418,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     h, N, lo, hi, tr = resolve_settings(case, harmonics, samples, fmin, fmax, transform)
     basis = FourierBasis(h, N)
     problem, info = build_problem(case, basis, tr)
-    # Hill's method needs M and C: not available on the condensed (receptance) problem
-    stability = bool(stability) and isinstance(problem, HarmonicBalance)
+    stability = bool(stability)
     w_lo, w_hi = 2 * np.pi * lo, 2 * np.pi * hi
     t0 = time.perf_counter()
     xscale = _unknown_scale(problem, case, w_lo, w_hi)

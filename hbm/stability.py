@@ -346,16 +346,13 @@ def hill_is_stable(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBa
 
 def point_is_stable(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> bool:
     """``point_stability(problem, X, w, options).stable`` by :func:`hill_is_stable`."""
-    _, J, _ = problem.residual(X, w)
-    fr = np.ix_(problem.free, problem.free)
-    return hill_is_stable(J, problem.model.M[fr], problem.model.C[fr], problem.basis, w, options)
+    J, M, C = problem.hill_system(X, w)
+    return hill_is_stable(J, M, C, problem.basis, w, options)
 
 
 def point_stability(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> HillResult:
-    """:func:`hill_stability` of the point ``X`` (n_coef, n) of a :class:`~hbm.residual.HarmonicBalance`.
-
-    Supports with imposed motion are not perturbed: the problem is restricted to the free DOFs.
-    """
-    _, J, _ = problem.residual(X, w)
-    fr = np.ix_(problem.free, problem.free)
-    return hill_stability(J, problem.model.M[fr], problem.model.C[fr], problem.basis, w, options)
+    """:func:`hill_stability` of the point ``X`` (n_coef, n) of a harmonic-balance problem,
+    on the system its ``hill_system`` gives (free DOFs of a full model: supports with imposed
+    motion are not perturbed; kept modal coordinates of a condensed one)."""
+    J, M, C = problem.hill_system(X, w)
+    return hill_stability(J, M, C, problem.basis, w, options)

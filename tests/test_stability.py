@@ -220,6 +220,20 @@ def test_predict_jumps_no_fold_and_lost_stability():
         predict_jumps(f, f[:-1], st)
 
 
+def test_a_landing_at_the_same_amplitude_is_no_jump():
+    # a branch that twists back by a hair (two points flagged unstable) and goes on along the
+    # same curve: a sweep lands where it was (zero size), which is no jump; landing 5 % higher
+    # still is one
+    f = np.r_[np.linspace(0.0, 0.5, 11), 0.52, 0.51, np.linspace(0.49, 1.0, 12)]
+    st = np.ones(f.size, bool)
+    st[[11, 12]] = False
+    assert predict_jumps(f, 1.0 + f, st) == {"up": [], "down": []}
+    a_step = np.where(np.arange(f.size) > 12, 1.05, 1.0) * (1.0 + f)
+    j = predict_jumps(f, a_step, st)
+    assert len(j["up"]) == 1 and len(j["down"]) == 1
+    assert j["up"][0]["amplitude_after"] == pytest.approx(1.05 * 1.5)
+
+
 # ---------------------------------------------------------------- stepped sine in the time domain
 
 @numba.njit(cache=True)
