@@ -77,3 +77,33 @@ def test_condensed_frf_has_the_full_verdicts_and_jumps(full_path):
             assert (c["amplitude_after"] is None) == (f["amplitude_after"] is None)
             if f["amplitude_after"] is not None:
                 assert c["amplitude_after"] == pytest.approx(f["amplitude_after"], rel=1e-3)
+
+
+def test_walk_with_skips_finds_the_duffing_chain_verdicts(full_path):
+    from hbm.stability import StabilityOptions
+    assert full_path.settings["stability_spectra"] == full_path.freq_hz.size     # default: every point
+    walk = frf(duffing_chain("full"), stability_options=StabilityOptions(max_skip=3))
+    assert walk.settings["stability_spectra"] < 0.8 * walk.freq_hz.size
+    assert np.array_equal(walk.stable, full_path.stable)
+
+
+def test_walk_probes_folds_and_finds_a_drifting_crossing():
+    from hbm.stability_path import path_stability
+    # margin drifts linearly through zero between points 40 and 41 of a monotone path
+    n = 100
+    freq = np.linspace(1.0, 2.0, n)
+    margin = 0.4 - 0.01 * np.arange(n)
+    calls = []
+
+    def test(k):
+        calls.append(k)
+        return bool(margin[k] < 0), float(margin[k])
+
+    stable, m = path_stability(test, freq, max_skip=8)
+    assert np.array_equal(stable, margin < 0)
+    assert len(calls) < n and np.isfinite(m).sum() == len(set(calls))
+    # a fold (frequency reversal) between probes: both its sides are probed
+    f2 = np.r_[np.linspace(1.0, 2.0, 50), np.linspace(1.99, 1.5, 50)]
+    calls.clear()
+    path_stability(lambda k: calls.append(k) or (True, -1.0), f2, max_skip=8)
+    assert {48, 49, 50} <= set(calls)
