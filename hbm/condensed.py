@@ -46,7 +46,7 @@ import numpy as np
 from .aft import NonlinearForces
 from .energy import EnergyBalance
 from .fourier import FourierBasis
-from .condensed_hill import modal_hill_system
+from .modal_hill import ModalData
 from .condensed_kernels import assemble, condensed_linear, modal_receptances, proportional_linear
 from .reduction import ReducedModel, condense, receptance_stack
 
@@ -375,28 +375,29 @@ class CondensedHarmonicBalance:
         F[:, d] = Fn
         return F
 
-    def nonlinear_jacobian(self, X: np.ndarray, w: float):
-        """``dF_nl/dU`` on every contact coordinate, (n_u, n_u), or ``None`` without elements."""
-        if not self.nl.n_nl:
+    def nonlinear_jacobian(self, X: np.ndarray, w: float, nl=None):
+        """``dF_nl/dU`` on every contact coordinate, (n_coef n_c, n_coef n_c), or ``None``
+        without elements.
+
+        ``nl`` : the elements' :class:`~hbm.aft.NonlinearForces` on another basis (``X`` then
+        has that basis' rows); default the problem's own."""
+        nl = self.nl if nl is None else nl
+        if not nl.n_nl:
             return None
-        d = self.nl.dofs
-        _, dFn, _ = self.nl.evaluate(np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float), w)
+        d = nl.dofs
+        _, dFn, _ = nl.evaluate(np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float), w)
         if self._nl_all:
             return dFn
-        Ja = np.zeros((self.n_unknowns, self.n_unknowns))
-        Ja[self._nl_ix] = dFn
+        nco, nc = nl.basis.n_coef, self.n_dof
+        idx = (np.arange(nco)[:, None] * nc + d[None, :]).ravel()
+        Ja = np.zeros((nco * nc, nco * nc))
+        Ja[np.ix_(idx, idx)] = dFn
         return Ja
 
-    def contact_modes(self):
-        """Kept mode shapes ``Phi_c`` (n_c, m) and residual flexibility ``R_cc`` (n_c, n_c) on
-        the contact coordinates."""
+    def modal_data(self) -> ModalData:
+        """The kept modes and residual flexibility on the contact coordinates (:mod:`hbm.modal_hill`)."""
         c = self._sl["c"]
-        return self._phi["c"], self._R_all[c, c]
-
-    def hill_system(self, X: np.ndarray, w: float):
-        """Jacobian, mass and damping of Hill's problem at a point (:mod:`hbm.condensed_hill`):
-        on the kept modal coordinates, ``(n_coef m, n_coef m)``, ``(m, m)``, ``(m, m)``."""
-        return modal_hill_system(self, X, w)
+        return ModalData(self.reduced.omega, self._phi["c"], self._R_all[c, c], self.reduced.modal_c)
 
     def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
         """Solution of ``(Z_c(w) + K_extra) U = F_eq(w)`` (n_coef, n_c): the start of Newton.

@@ -24,6 +24,7 @@ from .aft import NonlinearForces
 from .dense_kernels import dense_residual
 from .fourier import FourierBasis
 from .linear import LinearModel, fill_dynamic_stiffness, harmonic_blocks
+from .modal_hill import ModalData, modal_data_of
 
 
 class HarmonicBalance:
@@ -76,6 +77,8 @@ class HarmonicBalance:
             r += nr
         idx = (np.arange(basis.n_coef)[:, None] * n + self.nl.dofs[None, :]).ravel()
         self._nl_index = idx
+        self._nl_free = ~np.isin(self.nl.dofs, self.fixed)
+        self._modal = None
         h = basis.h_of_row
         self._h2 = (h * h).astype(float)
         # small dense models: Z(w) = Z0 + w Z1 - w^2 Z2 from three matrices built once
@@ -217,12 +220,30 @@ class HarmonicBalance:
                        dF, dFw.reshape(-1), A[:, :nu], R, A[:, nu])
         return R, A
 
-    def hill_system(self, X: np.ndarray, w: float):
-        """Jacobian ``dR/dX`` (n_u, n_u), mass and damping (n_free, n_free) of Hill's problem
-        (:mod:`hbm.stability`) at a point; supports with imposed motion are not perturbed."""
-        _, J, _ = self.residual(X, w)
-        fr = np.ix_(self.free, self.free)
-        return J, self.model.M[fr], self.model.C[fr]
+    def modal_data(self) -> ModalData:
+        """Every mode of the free DOFs seen from the free nonlinear DOFs (:mod:`hbm.modal_hill`);
+        supports with imposed motion are not perturbed.  Computed once."""
+        if self._modal is None:
+            dense = lambda A: A.toarray() if hasattr(A, "toarray") else np.asarray(A, dtype=float)
+            fr = np.ix_(self.free, self.free)
+            M, K, C = (dense(A)[fr] for A in (self.model.M, self.model.K, self.model.C))
+            rows = np.searchsorted(self.free, self.nl.dofs[self._nl_free])
+            self._modal = modal_data_of(M, K, C, rows)
+        return self._modal
+
+    def nonlinear_jacobian(self, X: np.ndarray, w: float, nl=None):
+        """``dF_nl/dX`` on the free nonlinear DOFs, (n_coef n_c, n_coef n_c), or ``None``.
+
+        ``nl`` : the elements' :class:`~hbm.aft.NonlinearForces` on another basis (``X`` then
+        has that basis' rows); default the problem's own."""
+        nl = self.nl if nl is None else nl
+        if not nl.n_nl or not self._nl_free.any():
+            return None
+        _, dF, _ = nl.evaluate(np.ascontiguousarray(X[:, nl.dofs]), w)
+        if self._nl_free.all():
+            return dF
+        k = (np.arange(nl.basis.n_coef)[:, None] * nl.n_nl + np.flatnonzero(self._nl_free)[None, :]).ravel()
+        return dF[np.ix_(k, k)]
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
         """``F_nl`` on all DOFs, (n_coef, n)."""

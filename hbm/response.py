@@ -28,7 +28,7 @@ from .newton import newton
 from .reduction_cache import cache_path, reduce_cached
 from .residual import HarmonicBalance
 from .resonances import ResonanceStepLimit, linear_resonances
-from .stability import StabilityOptions, point_is_stable
+from .stability import HillSystem, StabilityOptions, point_is_stable
 from .stability_path import hill_margin, path_stability
 from .structure import AUTO_CONDENSE_DOF
 from .transforms import make_transform
@@ -525,13 +525,13 @@ def _path_verdicts(problem, Xs, ws, segments, options):
         ``max Re(lambda) - tol w`` where a spectrum was computed, NaN elsewhere.
     """
     opts = options or StabilityOptions()
+    hill = HillSystem(problem)
     stable = np.ones(ws.size, dtype=bool)
     margin = np.full(ws.size, np.nan)
     for a, b in segments:
         def test(k, a=a):
             w = float(ws[a + k])
-            J, M, C = problem.hill_system(Xs[a + k], w)
-            return hill_margin(J, M, C, problem.basis, w, opts)
+            return hill_margin(*hill(Xs[a + k], w), hill.basis, w, opts)
         stable[a:b], margin[a:b] = path_stability(test, ws[a:b], opts.max_skip)
     return stable, margin
 

@@ -1,0 +1,139 @@
+r"""Hill's stability problem in modal coordinates, for every model (full or condensed).
+
+Every linear part is written in its modes: kept modal coordinates ``eta`` (``m`` of them,
+mass-normalised, natural frequencies ``Omega``, modal damping ``C_m``) and a static residual
+flexibility ``R`` on the nonlinear coordinates ``u`` (zero for a full model, whose every mode
+is kept; the truncated modes' flexibility for a condensed one, :mod:`hbm.condensed`):
+
+.. math::
+
+    \ddot\eta + C_m \dot\eta + \Omega^2 \eta = \Phi_c^T (-f_{nl}) + \Phi_e^T F_e , \qquad
+    u = \Phi_c \eta + R_{cc} (-f_{nl}) + R_{ce} F_e .
+
+A perturbation ``(delta eta, delta u)`` of a periodic solution, with the element forces
+linearised as ``delta f_nl = J_nl delta u`` (``J_nl`` the AFT Jacobian of the force
+harmonics, as in AFT-Hill), satisfies ``(I + R_cc J_nl) delta u = Phi_c delta eta`` (``R_cc``
+on every coefficient row: the residual term is static), so the modal equation is
+
+.. math::
+
+    \ddot{\delta\eta} + C_m \dot{\delta\eta} + \Omega^2 \delta\eta
+    + \underbrace{\Phi_c^T J_{nl} (I + R_{cc} J_{nl})^{-1} \Phi_c}_{K_{eff}} \delta\eta = 0 ,
+
+Hill's quadratic eigenproblem of :mod:`hbm.stability` with mass ``I``, damping ``C_m`` and the
+Jacobian ``J = Z_m(w) + K_eff`` (``Z_m`` the modal dynamic stiffness,
+:func:`hbm.linear.fill_dynamic_stiffness`).
+
+**Modes above the retained harmonics are static.**  A truncated Hill problem on harmonics up
+to ``H`` represents a mode of frequency ``Omega_k`` by the members of its exponent family
+``lambda - i j w`` with ``|j| <= H``; when ``Omega_k > (H + 1/2) w`` its in-strip member is the
+one at the edge of the truncation, whose eigenvector the truncation distorts, and with the
+non-smooth coupling of a friction contact such members come out with large spurious real
+parts.  Measured on ``benchmarks/upd_like.toml`` at 248.32 Hz (H = 3, 60 modes up to many
+times ``H w``): exponents of ``0.88 w`` (growth by ``e^{5.5}`` per period) while a time
+integration from rest settles on the solution (change per period 1e-6 after 300 periods);
+with every mode above ``(H + 1/2) w`` moved into the static flexibility,
+``R_cc + Phi_hi Omega_hi^{-2} Phi_hi^T``, the largest real part is ``-9e-5 w``: stable.  So
+those modes enter statically, exactly as the reduction treats its truncated modes, and
+the problem has ``2 m_dyn`` exponents, ``m_dyn`` the modes at or below the cut-off.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import scipy.linalg as sla
+
+from .linear import fill_dynamic_stiffness
+
+
+class ModalData(NamedTuple):
+    """A linear part in modal form, seen from its nonlinear coordinates.
+
+    Attributes
+    ----------
+    omega : ndarray, shape (m,)
+        Natural angular frequencies of the kept modes, rad/s, ascending.
+    phi_c : ndarray, shape (n_c, m)
+        Mode shapes at the nonlinear coordinates.
+    R_cc : ndarray, shape (n_c, n_c)
+        Static residual flexibility at the nonlinear coordinates (zeros if none).
+    C_m : ndarray, shape (m, m)
+        Modal damping matrix.
+    """
+
+    omega: np.ndarray
+    phi_c: np.ndarray
+    R_cc: np.ndarray
+    C_m: np.ndarray
+
+
+def modal_data_of(M, K, C, rows: np.ndarray) -> ModalData:
+    """Every mode of a dense model ``(M, K, C)`` seen from its coordinates ``rows``.
+
+    Parameters
+    ----------
+    M, K, C : ndarray, shape (n, n)
+        ``M`` positive definite.
+    rows : ndarray of int, shape (n_c,)
+
+    Returns
+    -------
+    ModalData
+        ``R_cc = 0`` (no mode is truncated).
+    """
+    lam, phi = sla.eigh(K, M)
+    C_m = phi.T @ C @ phi
+    return ModalData(np.sqrt(np.clip(lam, 0.0, None)), phi[rows], np.zeros((rows.size, rows.size)), C_m)
+
+
+def _block_rows(P: np.ndarray, n_coef: int) -> np.ndarray:
+    """The right-hand side ``Phi_c`` on every coefficient row, a (n_coef a, n_coef b) matrix
+    holding ``P`` (a, b) in its diagonal blocks."""
+    a, b = P.shape
+    B = np.zeros((n_coef, a, n_coef, b))
+    r = np.arange(n_coef)
+    B[r, :, r, :] = P
+    return B.reshape(n_coef * a, n_coef * b)
+
+
+def modal_hill_system(modal: ModalData, J_nl, basis, w: float, cutoff: float | None = None):
+    """Jacobian, mass and damping of the modal Hill problem (module doc) at a point.
+
+    Parameters
+    ----------
+    modal : ModalData
+    J_nl : ndarray, shape (n_coef n_c, n_coef n_c), or None
+        ``dF_nl/dU`` at the point on the nonlinear coordinates (``None``: no elements).
+    basis : FourierBasis
+    w : float
+        Angular frequency, rad/s.
+    cutoff : float, optional
+        Modes above this angular frequency enter statically; default ``(H + 1/2) w``.
+
+    Returns
+    -------
+    J : ndarray, shape (n_coef m_dyn, n_coef m_dyn)
+        ``Z_m(w) + K_eff`` on the coefficients of the modes at or below the cut-off.
+    M : ndarray, shape (m_dyn, m_dyn)
+        Identity (mass-normalised modes).
+    C : ndarray, shape (m_dyn, m_dyn)
+        Their modal damping.
+    """
+    nco = basis.n_coef
+    dyn = modal.omega <= ((max(basis.harmonics) + 0.5) * w if cutoff is None else cutoff)
+    m = int(dyn.sum())
+    om, phi_c = modal.omega, modal.phi_c
+    Cm = np.ascontiguousarray(modal.C_m[np.ix_(dyn, dyn)])
+    J = fill_dynamic_stiffness(np.zeros((nco * m, nco * m)), np.diag(om[dyn] ** 2), Cm, np.eye(m), basis, w)
+    if J_nl is None or m == 0:
+        return J, np.eye(m), Cm
+    nc = phi_c.shape[0]
+    hi = ~dyn
+    R = modal.R_cc + (phi_c[:, hi] / om[hi] ** 2) @ phi_c[:, hi].T
+    pc = phi_c[:, dyn]
+    RJ = (R @ J_nl.reshape(nco, nc, nco * nc)).reshape(nco * nc, nco * nc)
+    T = np.linalg.solve(np.eye(nco * nc) + RJ, _block_rows(pc, nco))     # delta u per delta eta
+    Y = (J_nl @ T).reshape(nco, nc, nco * m)
+    J += np.einsum("ca,icn->ian", pc, Y).reshape(nco * m, nco * m)        # Phi_c^T per coefficient row
+    return J, np.eye(m), Cm
