@@ -604,32 +604,48 @@ class _Packed:
                 self.vel, self.d_off)
 
 
+def _time_parts(element):
+    """``[(gather rows (n_part, n_dof), LawSpec, force names), ...]``: the laws the element
+    steps through in time (its :meth:`law_parts`: a wedge's flank contacts, one law for a
+    plain element)."""
+    parts = element.law_parts()
+    if not parts:
+        raise CaseError(f"element {element.name}: {type(element).__name__} has no time-step law; "
+                        f"the time-domain reference does not support it")
+    names = tuple(element.coord_names) if len(element.coord_names) == element.n_local else \
+        tuple(str(i) for i in range(element.n_local))
+    out = []
+    for rows, spec in parts:
+        rows = np.asarray(rows, dtype=np.int64)
+        if element.n_local == 1:
+            labels = (f"{element.name}_f",)
+        else:
+            labels = tuple(f"{element.name}_f_{names[r]}" for r in rows)
+        out.append((element.gather[rows], spec, labels))
+    return out
+
+
 def pack_elements(elements, n_dof: int) -> _Packed:
-    """Flat arrays of the elements for the kernel (kinds, params/states/gathers with offsets)."""
-    n_el = len(elements)
-    for e in elements:
-        if e.kind < 0:
-            raise CaseError(f"element {e.name}: {type(e).__name__} has no time-step law; "
-                            f"the time-domain reference does not support it")
-    kinds = np.array([e.kind for e in elements], dtype=np.int64)
+    """Flat arrays of the elements' law parts for the kernel (kinds, params/states/gathers
+    with offsets, one entry per part: :func:`_time_parts`)."""
+    parts = [p for e in elements for p in _time_parts(e)]
+    n_el = len(parts)
+    kinds = np.array([spec.kind for _, spec, _ in parts], dtype=np.int64)
     p_off = np.zeros(n_el + 1, dtype=np.int64)
     s_off = np.zeros(n_el + 1, dtype=np.int64)
     g_off = np.zeros(n_el + 1, dtype=np.int64)
     d_off = np.zeros(n_el + 1, dtype=np.int64)
     names = []
-    for i, e in enumerate(elements):
-        p_off[i + 1] = p_off[i] + e.params.size
-        s_off[i + 1] = s_off[i] + e.n_state
-        g_off[i + 1] = g_off[i] + e.n_local
-        d_off[i + 1] = d_off[i] + e.n_local * e.n_input
-        if e.n_local == 1:
-            names.append(f"{e.name}_f")
-        else:
-            cn = tuple(e.coord_names) if len(e.coord_names) == e.n_local else tuple(range(e.n_local))
-            names += [f"{e.name}_f_{c}" for c in cn]
-    p_all = np.concatenate([e.params for e in elements]) if n_el else np.zeros(0)
-    g_all = np.vstack([e.gather for e in elements]) if n_el else np.zeros((0, n_dof))
-    vel = np.array([1 if e.velocity else 0 for e in elements], dtype=np.int64)
+    for i, (G, spec, labels) in enumerate(parts):
+        n_local = G.shape[0]
+        p_off[i + 1] = p_off[i] + spec.params.size
+        s_off[i + 1] = s_off[i] + spec.n_state
+        g_off[i + 1] = g_off[i] + n_local
+        d_off[i + 1] = d_off[i] + n_local * n_local * (2 if spec.velocity else 1)
+        names += labels
+    p_all = np.concatenate([spec.params for _, spec, _ in parts]) if n_el else np.zeros(0)
+    g_all = np.vstack([G for G, _, _ in parts]) if n_el else np.zeros((0, n_dof))
+    vel = np.array([1 if spec.velocity else 0 for _, spec, _ in parts], dtype=np.int64)
     return _Packed(kinds, np.ascontiguousarray(p_all, dtype=float), p_off, s_off,
                    np.ascontiguousarray(g_all, dtype=float), g_off, vel, d_off, tuple(names))
 

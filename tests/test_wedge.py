@@ -369,3 +369,21 @@ def test_rig_blade_pair_wedge_runs_with_energy_balance():
     lo = res.freq_hz < 112
     assert 98 < res.freq_hz[lo][np.argmax(h[lo])] < 102
     assert res.freq_hz[~lo][np.argmax(h[~lo])] > 120
+
+
+def test_time_domain_steps_the_wedge_through_its_flank_contacts():
+    # the wedge was packed for time stepping as one friction3d law with no parameters (its
+    # forces came out of uninitialised memory); it now steps through its flank contacts and
+    # agrees with the harmonic balance (H = 7) well within the time reference's error estimate
+    from hbm.response import output_amplitudes, recover_outputs, solve_at
+    from hbm.timesim import TimeSimOptions, timesim
+    case = hbm.load_case(ROOT / "rigs" / "blade_pair_wedge.toml")
+    f = 100.0
+    X, basis, problem = solve_at(case, f, harmonics=7, samples=128)
+    Y = recover_outputs(problem, case, X, 2 * np.pi * f)
+    td = timesim(case, f, TimeSimOptions(steps=256, tol=1e-7))    # (1e-8: the slow slider drift)
+    assert td.converged
+    for i, name in enumerate(case.analysis.outputs):
+        h1 = output_amplitudes(basis, Y[:, i])[0]
+        assert abs(td.h1[name] / h1 - 1) < max(td.error_estimate, 1e-3)
+    assert np.all(np.isfinite(td.history.forces)) and np.abs(td.history.forces).max() < 1e3
