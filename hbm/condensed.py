@@ -420,8 +420,14 @@ class CondensedHarmonicBalance:
             K += e.gather.T @ e.linear_stiffness() @ e.gather
         return K
 
-    def linear_peak_amplitudes(self, ws, stuck_stiffness=None):
+    def modal_rows(self) -> np.ndarray:
+        """The contact coordinates that :meth:`modal_data`'s ``phi_c`` rows stand for: all."""
+        return np.arange(self.n_dof)
+
+    def linear_peak_amplitudes(self, ws, stuck_stiffness=None, stuck_damping=None):
         """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear responses.
+
+        ``stuck_damping`` is not used (the stuck limit adds the stiffness only).
 
         Returns
         -------

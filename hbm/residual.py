@@ -42,15 +42,18 @@ class HarmonicBalance:
         AFT transform built on ``basis``.
     base : tuple (dofs, amplitude), optional
         Support DOFs (k,) and the amplitudes (k,) of their imposed motion ``A cos(w t)``.
+    output_rows : ndarray, shape (n_o, n), optional
+        Output coordinates ``y = G_o q`` (:meth:`recover_outputs`; default every DOF).
     """
 
     def __init__(self, model: LinearModel, elements, basis: FourierBasis, force, transform,
-                 base=None):
+                 base=None, output_rows=None):
         if 1 not in basis.harmonics:
             raise ValueError("the harmonic list must contain harmonic 1 (the excitation's)")
         self.model = model
         self.basis = basis
         n = model.n_dof
+        self.output_rows = np.eye(n) if output_rows is None else np.atleast_2d(np.asarray(output_rows, dtype=float))
         self.n_dof = n
         self.nl = NonlinearForces(basis, elements, n, transform)
         Fex = np.zeros((basis.n_coef, n))
@@ -244,6 +247,38 @@ class HarmonicBalance:
             return dF
         k = (np.arange(nl.basis.n_coef)[:, None] * nl.n_nl + np.flatnonzero(self._nl_free)[None, :]).ravel()
         return dF[np.ix_(k, k)]
+
+    def recover_outputs(self, X: np.ndarray, w: float) -> np.ndarray:
+        """Output coefficients ``X G_o^T`` (n_coef, n_o) of a point ``X`` (n_coef, n)."""
+        return X @ self.output_rows.T
+
+    def modal_rows(self) -> np.ndarray:
+        """The DOFs (indices into ``n``) that :meth:`modal_data`'s ``phi_c`` rows stand for."""
+        return self.nl.dofs[self._nl_free]
+
+    def linear_peak_amplitudes(self, ws, Ks, Cs=None):
+        """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear
+        responses (stuck: ``K + Ks``, ``C + Cs``), supports' imposed motion included.
+
+        Returns
+        -------
+        free, stuck : ndarray, shape (n_free,)
+        """
+        fr, fx = self.free, self.fixed
+        amp_free, amp_stuck = np.zeros(fr.size), np.zeros(fr.size)
+        M, C, K = self.model.M, self.model.C, self.model.K
+        Cx = C if Cs is None else C + Cs
+        f = self.Fex[self.basis.row_of(1, "c"), fr]
+        yb = self.X_fixed[self.basis.row_of(1, "c"), fx]
+        for w in np.atleast_1d(ws):
+            for Kw, Cw, amp in ((K, C, amp_free), (K + Ks, Cx, amp_stuck)):
+                Zc = Kw - w * w * M + 1j * w * Cw
+                try:
+                    x = np.linalg.solve(Zc[np.ix_(fr, fr)], f - Zc[np.ix_(fr, fx)] @ yb)
+                except np.linalg.LinAlgError:
+                    continue
+                np.maximum(amp, np.abs(x), out=amp)
+        return amp_free, amp_stuck
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
         """``F_nl`` on all DOFs, (n_coef, n)."""

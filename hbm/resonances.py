@@ -28,9 +28,11 @@ so it never jumps over it, and inside the half-power band it is at most
 :math:`\ln(D / \zeta_r\omega_r) / \ln(1/(1-\alpha)) + 2/\beta` extra points per resonance.
 Damping ratios below ``ZETA_FLOOR`` count as ``ZETA_FLOOR`` (an undamped peak has no width).
 
-For the condensed (receptance) problem the limits come from its kept modes: the free
-frequencies and modal damping as they are, the stuck ones from the modal eigenproblem with
-:math:`\Phi_c^T K_s \Phi_c` added (the residual flexibility is left out of this estimate).
+Both limits come from the problem's modes (``problem.modal_data()``, :mod:`hbm.modal_hill`):
+the free frequencies and modal damping as they are, the stuck ones from the modal
+eigenproblem with :math:`\Phi_c^T K_s \Phi_c` (and :math:`\Phi_c^T C_s \Phi_c`) added.  For
+a full model every mode is kept, so this is the eigenproblem above in other coordinates; a
+condensed model's residual flexibility is left out of this estimate.
 """
 from __future__ import annotations
 
@@ -56,16 +58,15 @@ def _modes(K, M, C):
     return om, c / (2.0 * om * m)
 
 
-def linear_resonances(problem, M=None, C=None, K=None, Ks=None, Cs=None):
-    """Resonances of the free and the stuck linear limits.
+def linear_resonances(modal, Ks=None, Cs=None):
+    """Resonances of the free and the stuck linear limits, from a problem's modes.
 
     Parameters
     ----------
-    problem : HarmonicBalance or CondensedHarmonicBalance
-    M, C, K : ndarray, shape (n, n), optional
-        The full model's matrices (HarmonicBalance); their free DOFs are used.
-    Ks, Cs : ndarray, shape (n, n), optional
-        Stuck tangent stiffness and damping of the elements on the problem's DOFs.
+    modal : hbm.modal_hill.ModalData
+        The problem's kept modes seen from its nonlinear coordinates (``problem.modal_data()``).
+    Ks, Cs : ndarray, shape (n_c, n_c), optional
+        Stuck tangent stiffness and damping of the elements on those coordinates.
 
     Returns
     -------
@@ -74,20 +75,14 @@ def linear_resonances(problem, M=None, C=None, K=None, Ks=None, Cs=None):
     zeta : ndarray, shape (r,)
         Their damping ratios.
     """
-    reduced = getattr(problem, "reduced", None)
-    if reduced is not None:
-        om = np.asarray(reduced.omega, dtype=float)
-        Cm = np.asarray(reduced.modal_c, dtype=float)
-        keep = om > 0
-        z_free = np.diag(Cm)[keep] / (2.0 * om[keep])
-        Pc = problem.condensed.G_c @ reduced.phi                  # (n_c, m)
-        Km = np.diag(om ** 2) + Pc.T @ Ks @ Pc
-        o_s, z_s = _modes(Km, np.eye(om.size), Cm)
-        return np.r_[om[keep], o_s], np.r_[z_free, z_s]
-    fr = problem.free
-    sub = np.ix_(fr, fr)
-    o_f, z_f = _modes(K[sub], M[sub], C[sub])
-    o_s, z_s = _modes((K + Ks)[sub], M[sub], (C + Cs)[sub])
+    om = np.asarray(modal.omega, dtype=float)
+    Cm = np.asarray(modal.C_m, dtype=float)
+    P = modal.phi_c
+    Km = np.diag(om ** 2)
+    o_f, z_f = _modes(Km, np.eye(om.size), Cm)
+    Ks_m = Km if Ks is None else Km + P.T @ Ks @ P
+    Cs_m = Cm if Cs is None else Cm + P.T @ Cs @ P
+    o_s, z_s = _modes(Ks_m, np.eye(om.size), Cs_m)
     return np.r_[o_f, o_s], np.r_[z_f, z_s]
 
 

@@ -174,7 +174,7 @@ def build_problem(case: Case, basis: FourierBasis, transform: str):
     info = {"solver": solver, "n_dof": st.n_dof}
     if solver == "full":
         problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force, tr,
-                                  base=case.excitation.base)
+                                  base=case.excitation.base, output_rows=case.analysis.output_rows(st.n_dof))
         info.update(modes=None, reduction_seconds=0.0)
     elif case.excitation.base is not None:
         raise CaseError(f"{case.path}: [excitation] base (support motion) needs the full solver: "
@@ -205,16 +205,10 @@ def _stuck_stiffness(problem) -> np.ndarray:
     return K
 
 
-def _load(problem, w: float) -> np.ndarray:
-    """Excitation in the residual at ``w``: ``F_ex`` (full) or ``F_eq(w)`` (condensed)."""
-    return problem.load(w) if isinstance(problem, CondensedHarmonicBalance) else problem.Fex
-
-
 def recover_outputs(problem, case: Case, X: np.ndarray, w: float) -> np.ndarray:
-    """Output coefficients (n_coef, n_outputs) of a point ``X`` (n_coef, n) at ``w``."""
-    if isinstance(problem, CondensedHarmonicBalance):
-        return problem.recover_outputs(X, w)
-    return X @ case.analysis.output_rows(problem.n_dof).T
+    """Output coefficients (n_coef, n_outputs) of a point ``X`` (n_coef, n) at ``w``
+    (``problem.recover_outputs``: the problem was built with ``case``'s outputs)."""
+    return problem.recover_outputs(X, w)
 
 
 def _stuck_damping(problem) -> np.ndarray:
@@ -227,7 +221,7 @@ def _stuck_damping(problem) -> np.ndarray:
     return C
 
 
-def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
+def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
     """Per-unknown scale: geometric mean of the stuck and free linear peak responses per DOF
     (the stuck one alone where the free system leaves the DOF at rest).  "Stuck" adds every
     element's tangent at rest: ``linear_stiffness`` and, for velocity laws, ``linear_damping``.
@@ -235,26 +229,7 @@ def _unknown_scale(problem: HarmonicBalance, case: Case, w_lo: float, w_hi: floa
     The linear responses include the supports' imposed motion (base excitation).
     """
     ws = np.linspace(w_lo, w_hi, 41)
-    Ks = _stuck_stiffness(problem)
-    if isinstance(problem, CondensedHarmonicBalance):
-        amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, Ks)
-    else:
-        fr, fx = problem.free, problem.fixed
-        amp_free = np.zeros(fr.size)
-        amp_stuck = np.zeros(fr.size)
-        M, C, K = case.model.M, case.model.C, case.model.K
-        Cs = C + _stuck_damping(problem)
-        f = case.excitation.force[fr]
-        yb = problem.X_fixed[problem.basis.row_of(1, "c"), fx]
-        for w in ws:
-            for Kx, Cx, amp in ((K, C, amp_free), (K + Ks, Cs, amp_stuck)):
-                Zc = Kx - w * w * M + 1j * w * Cx
-                rhs = f - Zc[np.ix_(fr, fx)] @ yb
-                try:
-                    x = np.linalg.solve(Zc[np.ix_(fr, fr)], rhs)
-                except np.linalg.LinAlgError:
-                    continue
-                np.maximum(amp, np.abs(x), out=amp)
+    amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, _stuck_stiffness(problem), _stuck_damping(problem))
     # a DOF that only the elements couple to the force (free response nil) takes its stuck
     # amplitude, and one without any linear response (round-off) the largest scale: a
     # geometric mean with nil or the 1e-6 floor inflates it in the arclength (the path creeps)
@@ -347,12 +322,8 @@ class _Path:
 def _step_limit(problem, case, window) -> ResonanceStepLimit:
     """The FRF's parameter-step limit at the linear resonances of the free and stuck limits
     (:mod:`hbm.resonances`) inside ``window`` (rad/s)."""
-    Ks = _stuck_stiffness(problem)
-    if isinstance(problem, CondensedHarmonicBalance):
-        om, z = linear_resonances(problem, Ks=Ks)
-    else:
-        m = problem.model
-        om, z = linear_resonances(problem, m.M, m.C, m.K, Ks, _stuck_damping(problem))
+    d = np.ix_(problem.modal_rows(), problem.modal_rows())
+    om, z = linear_resonances(problem.modal_data(), _stuck_stiffness(problem)[d], _stuck_damping(problem)[d])
     return ResonanceStepLimit(om, z, window)
 
 

@@ -67,8 +67,7 @@ def test_linear_resonances_of_both_limits_and_the_step_limit():
     assert _step_limit(problem, case, (w0 + 2.0, 400.0)).omega.tolist() == [ws]
     # undamped modes get the floor width, not zero (no endless approach)
     assert ResonanceStepLimit([10.0], [0.0])(10.0, 1) == pytest.approx(0.5 * 1e-4 * 10.0)
-    om, z = linear_resonances(problem, case.model.M, case.model.C, case.model.K,
-                              np.zeros((1, 1)), np.zeros((1, 1)))
+    om, z = linear_resonances(problem.modal_data(), np.zeros((1, 1)), np.zeros((1, 1)))
     assert np.allclose(om, [w0, w0]) and np.allclose(z, 1.0 / w0)
 
 
