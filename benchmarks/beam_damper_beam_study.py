@@ -1,7 +1,7 @@
 """Beam-damper-beam rig of seed 002: FRFs for N = 10, 20, 50, 100 N and the damper's
 equivalent stiffness and damping against the relative platform displacement (Figs. 19/21).
 
-    PYTHONPATH=. python -m rigs.builders.beam_damper_beam        # the model (npz)
+    PYTHONPATH=. python -m rigs.make_beam_damper_beam_model        # the model (npz)
     PYTHONPATH=. python benchmarks/beam_damper_beam_study.py [-o rigs/beam_damper_beam]
 
 Per normal load the brush grid is sized to the Hertz contact at that load (half width

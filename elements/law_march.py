@@ -29,8 +29,8 @@ import numba as nb
 import numpy as np
 
 from .kinds import JENKINS, FRICTION3D
-from .kernels import march, march_body
-from .closure import march_newton, newton_body
+from .kernels import march_body
+from .closure import newton_body
 
 START_FIRST = 0
 START_ARGMAX = 1
@@ -150,12 +150,6 @@ def linear_shortcut(kind, p, z, K, f0):
         K[nt, nt] = kn
         return True
     return False
-
-
-def march_for(closure):
-    """:func:`elements.kernels.march` or :func:`elements.closure.march_newton` by ``closure``
-    (generic in the law: every law compiled in).  Prefer :func:`march_of`."""
-    return march_newton if closure == CLOSE_NEWTON else march
 
 
 def make_law_march(kind, closure):

@@ -6,7 +6,7 @@ Schema (``../shared/DESIGN.md``)::
     [model]       one source:  mass, stiffness [, dof_names]        (inline matrices)
                            |  file = "x.npz" | "x_K.mtx" | "x.op4"  (hbm.model_io)
                            |  builder = "beam" with [[model.beam]], [[model.body]],
-                              [[model.spring]] tables (rigs.builders.assembly)
+                              [[model.spring]] tables (hbm.builders.assembly)
                   damping:     damping (matrix) | rayleigh = [a, b] | modal_damping = z or [z1, ...]
                                (a file's C is used unless one of these is given)
                   solver:      solver = "auto" | "full" | "condensed", modes = 40 | "all",
@@ -250,7 +250,7 @@ def _model(t, path, base_dir):
             raise CaseError(f"{path}: [model] unknown builder {t['builder']!r} (known: {', '.join(BUILDERS)})")
         if "dof_names" in t:
             raise CaseError(f"{path}: [model] dof_names cannot be given with a builder (it names the DOFs)")
-        from rigs.builders.assembly import build_assembly
+        from hbm.builders.assembly import build_assembly
         try:
             a = build_assembly(t.get("beam", []), t.get("body", []), t.get("spring", []))
         except ValueError as exc:

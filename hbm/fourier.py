@@ -169,13 +169,6 @@ class FourierBasis:
             raise KeyError(f"harmonic {h} is not in the basis")
         return int(idx[0] if (h == 0 or part == "c") else idx[1])
 
-    def fine_grid(self, n_fine: int | None = None) -> np.ndarray:
-        """Synthesis matrix on a fine grid (for max over a period), shape (n_fine, n_coef)."""
-        n_fine = n_fine or max(512, 32 * int(self.harmonics.max()))
-        theta = 2.0 * np.pi * np.arange(n_fine) / n_fine
-        return basis_matrix(self.h_of_row, theta)
-
-
 def basis_matrix(h_of_row: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """Synthesis matrix at arbitrary phases ``theta`` (n_t,), shape (n_t, n_coef)."""
     out = np.empty((theta.size, h_of_row.size))
@@ -190,14 +183,6 @@ def basis_matrix(h_of_row: np.ndarray, theta: np.ndarray) -> np.ndarray:
             out[:, k + 1] = np.sin(h * theta)
             k += 2
     return out
-
-
-def first_harmonic_amplitude(basis: FourierBasis, X: np.ndarray) -> np.ndarray:
-    """``sqrt(Xc1^2 + Xs1^2)`` for every column of ``X`` (n_coef, m) -> (m,); 0 if 1 not in H."""
-    if 1 not in basis.harmonics:
-        return np.zeros(X.shape[1:])
-    rc = basis.row_of(1, "c")
-    return np.hypot(X[rc], X[rc + 1])
 
 
 def max_abs(basis: FourierBasis, X: np.ndarray, n_fine: int | None = None) -> np.ndarray:

@@ -154,11 +154,6 @@ class LinearModel:
         return LinearModel(sla.block_diag(self.M, M_add), sla.block_diag(self.C, np.zeros((m, m))),
                            sla.block_diag(self.K, K_add), old + names)
 
-    def natural_frequencies_hz(self) -> np.ndarray:
-        """Undamped natural frequencies in Hz, ascending."""
-        lam = sla.eigh(self.K, self.M, eigvals_only=True)
-        return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi)
-
 
 def harmonic_blocks(model: LinearModel, basis: FourierBasis, w: float):
     """Per-harmonic dynamic stiffness blocks and their w-derivatives.

@@ -182,10 +182,6 @@ class ReducedModel:
     def n_modes(self) -> int:
         return int(self.omega.size)
 
-    def natural_frequencies_hz(self) -> np.ndarray:
-        """Kept natural frequencies in Hz, shape (m,)."""
-        return self.omega / (2.0 * np.pi)
-
     def receptance(self, W: float, derivative: bool = False):
         """Complex receptance ``H(W)`` at the kept DOFs, shape (n_keep, n_keep).
 

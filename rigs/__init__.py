@@ -1,1 +1,1 @@
-"""Seed systems and user cases as data (TOML), and the builders that read them."""
+"""Seed systems and user cases as data (TOML), the scripts that make their model files, and their studies."""

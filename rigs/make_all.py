@@ -17,7 +17,7 @@ RIGS = {
     "cross_beam": ("rigs/make_cross_beam_model.py", ["rigs/studies/cross_beam_study.py"]),
     "railcar_wedge": ("rigs/make_railcar_wedge_model.py", ["rigs/studies/railcar_wedge_sweep.py"]),
     "blade_couple": (None, ["rigs/make_blade_couple.py"]),
-    "beam_damper_beam": ("rigs/builders/beam_damper_beam.py",
+    "beam_damper_beam": ("rigs/make_beam_damper_beam_model.py",
                          ["benchmarks/beam_damper_beam_study.py", "benchmarks/brush_loops.py"]),
     "upd_rig": (None, ["rigs/make_upd_rig.py"]),      # no model file: the case builds its beams
 }

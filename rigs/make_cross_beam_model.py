@@ -6,7 +6,7 @@ Structure (planar, x horizontal, y up; steel ``E = 210 GPa``, ``rho = 7850 kg/m^
   (in-plane), width 30 mm;
 - horizontal "platform" of length ``LH = 0.16 m`` crossing the blade at height ``HJ = 0.15 m``,
   thickness ``t_h``, width 30 mm;
-- 2-node Euler-Bernoulli frame elements (the builder's :func:`rigs.builders.beam.element_matrices`,
+- 2-node Euler-Bernoulli frame elements (the builder's :func:`hbm.builders.beam.element_matrices`,
   consistent mass, in-plane DOFs ``ux, uy, rz`` kept), 8 elements per half beam.
 
 The paper's dimensions were lost in the text extraction; ``t_v`` and ``t_h`` are chosen by
@@ -46,7 +46,7 @@ from scipy.optimize import least_squares
 
 import sys
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from rigs.builders.beam import element_matrices, local_axes, Section, Material   # noqa: E402
+from hbm.builders.beam import element_matrices, local_axes, Section, Material   # noqa: E402
 
 E, RHO, NU = 210e9, 7850.0, 0.3
 LV, LH, HJ, WIDTH = 0.30, 0.16, 0.15, 0.03

@@ -6,8 +6,8 @@ import scipy.sparse as sp
 
 from hbm.linear import LinearModel
 from hbm.reduction import reduce_model
-from rigs.builders import BUILDERS
-from rigs.builders.beam import Section, build_beam_model, rigid_offset_rows
+from hbm.builders import BUILDERS
+from hbm.builders.beam import Section, build_beam_model, rigid_offset_rows
 
 E, RHO, NU = 210e9, 7800.0, 0.3
 L, B, H = 0.5, 0.02, 0.01

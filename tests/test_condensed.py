@@ -267,7 +267,7 @@ def test_energy_check_detects_a_wrong_solution():
 
 def test_two_beams_with_a_coupling_spring():
     """Identical beams coupled at the tips: in-phase mode unchanged, out-of-phase mode stiffer."""
-    from rigs.builders.assembly import build_assembly
+    from hbm.builders.assembly import build_assembly
     beam = {"length": 0.2, "n_elements": 8, "E": 7e10, "rho": 2700.0, "width": 0.02, "height": 0.005}
     single = build_assembly([beam], sparse=False)
     pair = build_assembly([{**beam, "name": "a"}, {**beam, "name": "b", "origin": [0.0, 0.1, 0.0]}],

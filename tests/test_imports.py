@@ -1,4 +1,5 @@
-"""Layer rules: continuation/ imports nothing of hbm/ or elements/; elements/ nothing of hbm/."""
+"""Layer rules: continuation/ imports nothing of hbm/ or elements/; elements/ nothing of hbm/;
+the library (hbm/, elements/, continuation/) nothing of rigs/ (its cases and scripts)."""
 import ast
 from pathlib import Path
 
@@ -25,3 +26,8 @@ def test_continuation_is_independent():
 def test_elements_do_not_import_hbm():
     mods = imported_modules("elements")
     assert not mods & {"hbm", "continuation", "rigs"}, mods
+
+
+def test_the_library_does_not_import_rigs():
+    for pkg in ("hbm", "elements", "continuation"):
+        assert "rigs" not in imported_modules(pkg), pkg

@@ -8,7 +8,7 @@ import scipy.sparse as sp
 
 from hbm.model_io import (load_model_file, read_matrix_market, read_npz, read_op4,
                           read_op4_model, write_op4)
-from rigs.builders.beam import build_beam_model
+from hbm.builders.beam import build_beam_model
 
 DATA = Path(__file__).parent / "data"
 

@@ -4,7 +4,7 @@ their platforms.  Writes ``rigs/beam_damper_beam_model.npz`` (arrays ``M``, ``K`
 
 Model (SI units):
 
-- two identical vertical steel beams (axis ``z``) from :func:`rigs.builders.beam.build_beam_model`,
+- two identical vertical steel beams (axis ``z``) from :func:`hbm.builders.beam.build_beam_model`,
   clamped at their root node into the block, at ``x = 0`` (beam A) and ``x = gap`` (beam B);
   only the bending DOFs ``ux, uy, rx, ry`` are kept (for straight beams the axial and torsion
   DOFs are uncoupled from them, so dropping them is exact); a platform point mass at node
@@ -40,7 +40,7 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.optimize import brentq
 
-from .beam import build_beam_model
+from hbm.builders.beam import build_beam_model
 
 KEEP = ("ux", "uy", "rx", "ry")
 DEFAULTS = dict(E=210e9, rho=7850.0, nu=0.3, width=0.040, height=0.080, n_elements=12, platform_node=6,

@@ -1,7 +1,7 @@
 r"""Assemblies of beams, lumped bodies and coupling springs, built from readable case keys.
 
 The structure is the direct sum of its parts (each beam from
-:func:`rigs.builders.beam.build_beam_model`, each body a lumped mass) coupled by linear
+:func:`hbm.builders.beam.build_beam_model`, each body a lumped mass) coupled by linear
 springs:
 
 .. math::
@@ -13,7 +13,7 @@ springs:
 where ``r_{a,i}`` is row ``i`` of the coordinates of the spring's first end (a node's
 translations ``x, y, z`` then rotations, a rigid-offset point's or a body's translations),
 ``r_{b,i}`` that of the second end (zero for ground).  A rigid-offset point moves by
-``u_p = u_n + theta_n x r`` (see :mod:`rigs.builders.beam`).
+``u_p = u_n + theta_n x r`` (see :mod:`hbm.builders.beam`).
 
 Names
 -----
