@@ -39,5 +39,8 @@ rig-models: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/time_vs_error.py
 
+# numba caches too: a kernel cached in one file keeps an inlined law from another file
+# until its own file changes (after editing a law, `make clean`)
 clean:
 	rm -rf out .pytest_cache
+	find hbm elements continuation -name '*.nbi' -delete -o -name '*.nbc' -delete

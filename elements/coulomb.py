@@ -5,7 +5,7 @@ import numpy as np
 
 from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
 from .kinds import COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
-from .laws.coulomb import LINEAR, ARCTAN
+from .laws.coulomb import LINEAR, ARCTAN, TANH
 from .law_march import START_ARGMAX
 
 
@@ -61,8 +61,8 @@ class CoulombStickSlip(Element):
 class CoulombRegularised(Element):
     """Velocity-regularised Coulomb friction (seed 001, eq. 2.2), memory-less in ``u``.
 
-    ``f = Ft0 sat(v / v_r)`` (``law = "linear"``) or ``f = Ft0 (2/pi) arctan(v / v_r)``
-    (``law = "arctan"``).  Case keys: ``type``, ``dofs``, ``slip_force`` (Ft0 >= 0),
+    ``f = Ft0 sat(v / v_r)`` (``law = "linear"``), ``f = Ft0 (2/pi) arctan(v / v_r)``
+    (``law = "arctan"``) or ``f = Ft0 tanh(v / v_r)`` (``law = "tanh"``).  Case keys: ``type``, ``dofs``, ``slip_force`` (Ft0 >= 0),
     ``v_r`` (> 0), ``law`` (default ``"linear"``), optional ``name``.  Inputs ``[u, v]``;
     state ``[f]``.
     """
@@ -76,7 +76,7 @@ class CoulombRegularised(Element):
     quantities = ("slip_fraction", "force_amplitude", "dissipation")
     default_harmonics = 9           # benchmarks/default_harmonics.py
     default_samples_factor = 2
-    laws = {"linear": LINEAR, "arctan": ARCTAN}
+    laws = {"linear": LINEAR, "arctan": ARCTAN, "tanh": TANH}
 
     def __init__(self, gather, slip_force, v_r, law="linear", name="coulomb_regularised"):
         if law not in self.laws:
@@ -96,10 +96,10 @@ class CoulombRegularised(Element):
         return np.zeros((1, 1))
 
     def linear_damping(self):
-        """Viscous tangent at rest, ``df/dv`` at ``v = 0``: ``Ft0 / v_r`` (linear) or
+        """Viscous tangent at rest, ``df/dv`` at ``v = 0``: ``Ft0 / v_r`` (linear, tanh) or
         ``2 Ft0 / (pi v_r)`` (arctan)."""
         F0, vr = self.params[0], self.params[1]
-        c = F0 / vr if self.law == "linear" else 2.0 * F0 / (np.pi * vr)
+        c = 2.0 * F0 / (np.pi * vr) if self.law == "arctan" else F0 / vr
         return np.array([[c]])
 
     def summary(self, f, z):

@@ -126,21 +126,19 @@ def reg(law, F0=0.5, vr=0.2):
     return CoulombRegularised(np.eye(1), slip_force=F0, v_r=vr, law=law)
 
 
-@pytest.mark.parametrize("law", ["linear", "arctan"])
+@pytest.mark.parametrize("law", ["linear", "arctan", "tanh"])
 def test_regularised_closed_form(law):
     el = reg(law)
     v = np.linspace(-1.0, 1.0, 41)
     step = stepper(el)
     f = np.array([step([123.0, vv])[0] for vv in v])     # u does not matter
-    if law == "linear":
-        expect = 0.5 * np.clip(v / 0.2, -1.0, 1.0)
-    else:
-        expect = 0.5 * (2 / np.pi) * np.arctan(v / 0.2)
+    expect = {"linear": 0.5 * np.clip(v / 0.2, -1.0, 1.0), "arctan": 0.5 * (2 / np.pi) * np.arctan(v / 0.2),
+              "tanh": 0.5 * np.tanh(v / 0.2)}[law]
     np.testing.assert_allclose(f, expect, rtol=1e-14, atol=1e-16)
     assert el.velocity and not el.needs_mean and el.n_input == 2
 
 
-@pytest.mark.parametrize("law, amp", [("linear", 0.1), ("linear", 0.5), ("arctan", 0.5)])
+@pytest.mark.parametrize("law, amp", [("linear", 0.1), ("linear", 0.5), ("arctan", 0.5), ("tanh", 0.5)])
 def test_regularised_fd_jacobian_with_velocity_seeds(law, amp):
     el = reg(law)
     w = 1.7
@@ -177,7 +175,8 @@ def test_from_spec_keys_and_validation():
     assert CoulombRegularised.from_spec({k: v for k, v in rspec.items() if k != "law"}, 2,
                                         dof_index={"x": 1}).law == "linear"
     with pytest.raises(ValueError, match="law"):
-        CoulombRegularised.from_spec({**rspec, "law": "tanh"}, 2, dof_index={"x": 1})
+        CoulombRegularised.from_spec({**rspec, "law": "sigmoid"}, 2, dof_index={"x": 1})
+    assert CoulombRegularised.from_spec({**rspec, "law": "tanh"}, 2, dof_index={"x": 1}).law == "tanh"
     with pytest.raises(ValueError, match="v_r"):
         CoulombRegularised.from_spec({**rspec, "v_r": 0.0}, 2, dof_index={"x": 1})
     with pytest.raises(ValueError, match="'mu'"):

@@ -24,7 +24,8 @@ velocity ``v = z[1]``:
 .. math::
 
     f = F_{t0}\, \mathrm{sat}(v / v_r) \quad (\text{law } 0, \text{linear}), \qquad
-    f = F_{t0}\, \tfrac{2}{\pi} \arctan(v / v_r) \quad (\text{law } 1, \text{arctan})
+    f = F_{t0}\, \tfrac{2}{\pi} \arctan(v / v_r) \quad (\text{law } 1, \text{arctan}), \qquad
+    f = F_{t0} \tanh(v / v_r) \quad (\text{law } 2, \text{tanh, as in NLvib's examples})
 
 State ``s = [f]``, input ``z = [u, v]``, parameters ``p = [Ft0, v_r, law]``.
 """
@@ -36,6 +37,7 @@ import numba as nb
 
 LINEAR = 0
 ARCTAN = 1
+TANH = 2
 
 
 @nb.njit(cache=True, inline="always")
@@ -100,6 +102,9 @@ def _regularised(p, v):
     x = v / vr
     if int(p[2]) == ARCTAN:
         return F0 * (2.0 / math.pi) * math.atan(x), F0 * (2.0 / math.pi) / (vr * (1.0 + x * x))
+    if int(p[2]) == TANH:
+        t = math.tanh(x)
+        return F0 * t, F0 * (1.0 - t * t) / vr
     if x > 1.0:
         return F0, 0.0
     if x < -1.0:
