@@ -270,6 +270,9 @@ def hill_stability(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBa
     opts = options or StabilityOptions()
     n = M.shape[0]
     nu = basis.n_coef * n
+    if n == 0:              # no dynamic mode left (all static): nothing can lose stability
+        empty = np.zeros(0, dtype=complex)
+        return HillResult(empty, empty, np.zeros(0), -np.inf, True)
     A = hill_matrix(J, M, C, basis, w)
     lam, V = sla.eig(A, check_finite=True)
     j, W = complex_index_weights(V[:nu], basis, n)
@@ -345,6 +348,8 @@ def hill_is_stable(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBa
     the eigenvectors this falls back to :func:`hill_stability`.
     """
     opts = options or StabilityOptions()
+    if M.shape[0] == 0:
+        return True
     A = hill_matrix(J, M, C, basis, w)
     if not np.all(np.isfinite(A)):
         return hill_stability(J, M, C, basis, w, opts).stable      # raises as eig does
@@ -412,7 +417,7 @@ def point_is_stable(problem, X: np.ndarray, w: float, options: StabilityOptions 
 
 def point_stability(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> HillResult:
     """:func:`hill_stability` of the point ``X`` (n_coef, n) of a harmonic-balance problem, on
-    its modal Hill system (:class:`HillSystem`): the modes at or below ``(H + 1/2) w`` of the
+    its modal Hill system (:class:`HillSystem`): the modes at or below ``(2 H + 1/2) w`` of the
     free DOFs (supports with imposed motion are not perturbed) or of a condensed model."""
     hs = HillSystem(problem)
     return hill_stability(*hs(X, w), hs.basis, w, options)

@@ -52,6 +52,8 @@ def hill_margin(J, M, C, basis, w: float, options: StabilityOptions | None = Non
         upper bound of the kept exponents'); negative when stable.
     """
     opts = options or StabilityOptions()
+    if M.shape[0] == 0:
+        return True, -np.inf
     A = hill_matrix(J, M, C, basis, w)
     if not np.all(np.isfinite(A)):
         raise ValueError("Hill matrix is not finite (a non-finite Jacobian at a converged point)")
