@@ -674,7 +674,7 @@ class _State:
 
     def __init__(self, case: Case, packed: _Packed, F: np.ndarray, w: float = 0.0):
         n = case.n_dof
-        M, C, K = case.model.M, case.model.C, case.model.K
+        K = case.model.K
         fixed, ybase = _support(case)
         fx = np.flatnonzero(fixed)
         fr = np.flatnonzero(fixed == 0)
@@ -690,8 +690,17 @@ class _State:
         self.Dref = np.zeros(packed.kinds.size)
         _init_states(*packed.args(), self.q, self.v, self.S, self.D, self.Dref)
         self.fnl = np.zeros(n)
-        _element_forces(self.S, packed.s_off, packed.g_all, packed.g_off, self.q, self.fnl)
         self.a = np.zeros(n)
+        self.rebalance(case, packed, F, w)
+
+    def rebalance(self, case: Case, packed: _Packed, F: np.ndarray, w: float) -> None:
+        """Element forces from the states and the acceleration that balances the equations
+        at phase 0 (load ``F``), for the present ``q``, ``v``, ``S``."""
+        M, C, K = case.model.M, case.model.C, case.model.K
+        fixed, ybase = _support(case)
+        fx = np.flatnonzero(fixed)
+        fr = np.flatnonzero(fixed == 0)
+        _element_forces(self.S, packed.s_off, packed.g_all, packed.g_off, self.q, self.fnl)
         self.a[fx] = -w * w * ybase[fx]
         rhs = F - C @ self.v - K @ self.q - self.fnl - M[:, fx] @ self.a[fx]
         self.a[fr] = np.linalg.solve(M[np.ix_(fr, fr)], rhs[fr])
