@@ -39,7 +39,6 @@ the same check as the full model's (there ``-W[R, \dot X]``).
 from __future__ import annotations
 
 import copy
-from typing import NamedTuple
 
 import numpy as np
 
@@ -47,8 +46,9 @@ from .aft import NonlinearForces
 from .energy import EnergyBalance
 from .fourier import FourierBasis
 from .modal_hill import ModalData
-from .condensed_kernels import assemble, condensed_linear, modal_receptances, proportional_linear
-from .reduction import ReducedModel, condense, receptance_stack
+from .condensed_kernels import assemble
+from .condensed_linear import LinearBuilder, LinearPart
+from .reduction import ReducedModel, condense
 
 _RANK_TOL = 1e-10
 
@@ -107,40 +107,15 @@ def _regathered(element, A):
     return e
 
 
-class _LinearPart(NamedTuple):
-    """The linear part at one fundamental frequency ``w`` (see :meth:`CondensedHarmonicBalance._linear`).
-
-    Attributes
-    ----------
-    H, dH : ndarray, complex, shape (n_h, n_p, n_p)
-        Receptances and their ``W``-derivatives between all kept coordinates (contact,
-        excitation, output, in that order) at ``W = h w`` for every harmonic.
-    Z : ndarray, complex, shape (n_h, n_c, n_c)
-        ``Z_c(h w) = H_cc^{-1}``.
-    J, dJ : ndarray, shape (n_u, n_u)
-        ``dR/dU`` of the linear part (``Z_c`` in real block form on the unknown vector) and its
-        ``w``-derivative (``h dZ_c/dW`` per harmonic).
-    F, dF : ndarray, shape (n_u,)
-        Equivalent contact load ``F_eq`` and ``dF_eq/dw``, flattened like the unknowns.
-    """
-
-    H: np.ndarray
-    dH: np.ndarray
-    Z: np.ndarray
-    J: np.ndarray
-    dJ: np.ndarray
-    F: np.ndarray
-    dF: np.ndarray
-
-
 class CondensedHarmonicBalance:
     """Residual ``R(U, w)`` on the contact coordinates (module docstring); the interface of
     :class:`hbm.residual.HarmonicBalance` used by :mod:`hbm.response` and :mod:`hbm.energy`.
 
-    Every harmonic is handled at once, in one compiled call (:mod:`hbm.condensed_kernels`):
-    the receptances of all kept coordinates from one product over the modes, ``Z_c`` per
-    harmonic, and the real Jacobian ``dR/dU`` of the linear part with its ``w``-derivative, so
-    that a residual is two matrix-vector products plus the AFT.  The linear part is memoised
+    The linear part at a frequency, ``Z_c`` and ``h dZ_c/dW`` per harmonic with the equivalent
+    load, comes from :class:`hbm.condensed_linear.LinearBuilder` (few contacts: one compiled
+    call; many: the Woodbury form on quantities factored once); one compiled call then writes
+    ``Z_c`` into the Jacobian beside the AFT's, so no ``n_u x n_u`` matrix of the linear part
+    is ever formed.  The linear part is memoised
     for the last ``w`` and the nonlinear forces for the last residual evaluation (exact ``X``
     and ``w`` only: re-used, they are the same numbers).
 
@@ -158,6 +133,9 @@ class CondensedHarmonicBalance:
         AFT transform built on ``basis``.
     output_rows : ndarray, shape (n_o, n_dof), optional
         Output coordinates ``y = G_o q`` (default: the force's direction).
+    linear_strategy : str
+        How the linear part is formed (:class:`hbm.condensed_linear.LinearBuilder`): ``auto``
+        or one of ``compiled``, ``woodbury``, ``dense`` (the same numbers to round-off).
 
     Attributes
     ----------
@@ -170,7 +148,7 @@ class CondensedHarmonicBalance:
     """
 
     def __init__(self, reduced: ReducedModel, elements, basis: FourierBasis, force, transform,
-                 output_rows=None):
+                 output_rows=None, linear_strategy: str = "auto"):
         if 1 not in basis.harmonics:
             raise ValueError("the harmonic list must contain harmonic 1 (the excitation's)")
         n = reduced.n_dof
@@ -204,10 +182,6 @@ class CondensedHarmonicBalance:
         self._R_all = G_all @ reduced.residual @ G_all.T
         self._om2 = np.ascontiguousarray(reduced.omega ** 2)
         self._cdiag = np.ascontiguousarray(np.diag(reduced.modal_c))
-        ia, ib = np.triu_indices(self._phi_all.shape[0])
-        self._tri = (ia.astype(np.int64), ib.astype(np.int64))
-        self._Pu = np.ascontiguousarray(self._phi_all[ia].T * self._phi_all[ib].T)   # (m, n_t)
-        self._Ru = np.ascontiguousarray(self._R_all[ia, ib])
         self._phi = {k: self._phi_all[s] for k, s in self._sl.items()}
         # harmonic rows: cosine (or mean) row of every harmonic, sine rows of h > 0
         h = np.asarray(basis.harmonics)
@@ -225,6 +199,8 @@ class CondensedHarmonicBalance:
         to_r[self._rc, np.arange(h.size)] = 1.0
         to_r[self._rs, self._pos] = 1j
         self._to_c, self._to_r = to_c, to_r
+        self._builder = LinearBuilder(reduced, self._phi_all, self._R_all, nc, ne, self._h, self._rc, self._i1,
+                                      linear_strategy)
         self._Fe_c = self._complex(F_e)
         self._ge = self._Fe_c @ self._phi["e"]          # Phi^T G_e^T F_e per harmonic, (n_h, m)
         d = self.nl.dofs
@@ -267,37 +243,15 @@ class CondensedHarmonicBalance:
         return (self._to_r @ Y).real
 
     # ------------------------------------------------------------------ linear part
-    def _receptances(self, Ws: np.ndarray):
-        """``H(W)`` and ``dH/dW`` between all kept coordinates, (n_W, n_p, n_p) complex."""
-        r = self.reduced
-        Ws = np.ascontiguousarray(Ws, dtype=float)
-        if r.proportional:
-            return modal_receptances(self._Pu, *self._tri, self._phi_all.shape[0], self._om2,
-                                     self._cdiag, self._Ru, Ws)
-        H, dH = receptance_stack(self._phi_all, r.omega, r.modal_c, False, self._R_all, Ws)
-        return np.ascontiguousarray(H), np.ascontiguousarray(dH)
-
-    def _linear(self, w: float) -> _LinearPart:
-        """The linear part at ``w`` (:class:`_LinearPart`), from one compiled call
-        (:mod:`hbm.condensed_kernels`).
+    def _linear(self, w: float) -> LinearPart:
+        """The linear part at ``w`` (:class:`hbm.condensed_linear.LinearPart`).
 
         Memoised for the last ``w`` only (Newton at a fixed frequency re-uses it).
         """
         w = float(w)
-        if self._memo_w == w:
-            return self._memo
-        rows, nc, ie, i1 = self._rc, self.n_dof, self._sl["e"].start, self._i1
-        if self.reduced.proportional:
-            ok, H, dH, Z, JJ, FF = proportional_linear(
-                self._Pu, *self._tri, self._phi_all.shape[0], self._om2, self._cdiag, self._Ru,
-                self._h, w, rows, nc, ie, i1)
-        else:
-            H, dH = self._receptances(self._h * w)
-            ok, Z, JJ, FF = condensed_linear(H, dH, self._h, rows, nc, ie, i1)
-        if not ok:
-            raise ValueError("contact receptance is singular (dependent contact coordinates?)")
-        self._memo = _LinearPart(H, dH, Z, JJ[0], JJ[1], FF[0], FF[1])
-        self._memo_w = w
+        if self._memo_w != w:
+            self._memo = self._builder(w)
+            self._memo_w = w
         return self._memo
 
     def load(self, w: float) -> np.ndarray:
@@ -334,11 +288,12 @@ class CondensedHarmonicBalance:
     def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray, dRw: np.ndarray) -> np.ndarray:
         """``R`` (n_u,) returned; ``dR/dU`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw`` (n_u,)."""
         L = self._linear(w)
-        x = X.reshape(-1)
+        x = np.ascontiguousarray(X.reshape(-1), dtype=float)
         if not self.nl.n_nl:
-            J[...] = L.J
-            dRw[...] = L.dJ @ x - L.dF
-            return L.J @ x - L.F
+            z = np.zeros(x.size)
+            R = np.empty(x.size)
+            assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, x, z, np.zeros((x.size, x.size)), z, J, R, dRw)
+            return R
         d = self.nl.dofs
         Xn = np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float)
         Fn, dFn, dFw = self.nl.evaluate(Xn, w)
@@ -351,8 +306,8 @@ class CondensedHarmonicBalance:
             Ja[self._nl_ix] = dFn
             Fn, dFw, dFn = Fa, dFa, Ja
         R = np.empty(x.size)
-        assemble(L.J, L.dJ, L.F, L.dF, np.ascontiguousarray(x, dtype=float), Fn.reshape(-1), dFn,
-                 dFw.reshape(-1), J, R, dRw)
+        assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, x, np.ascontiguousarray(Fn.reshape(-1)),
+                 dFn, np.ascontiguousarray(dFw.reshape(-1)), J, R, dRw)
         return R
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
@@ -435,34 +390,31 @@ class CondensedHarmonicBalance:
         """
         Ks = self.stuck_stiffness() if stuck_stiffness is None else stuck_stiffness
         ws = np.atleast_1d(np.asarray(ws, dtype=float))
-        H, _ = self._receptances(ws)
-        c, e = self._sl["c"], self._sl["e"]
-        u = H[:, c, e][:, :, 0]                              # (n_w, n_c)
-        free = np.max(np.abs(u), axis=0, initial=0.0)
-        A = np.eye(self.n_dof) + H[:, c, c] @ Ks
-        try:
-            us = np.linalg.solve(A, u[:, :, None])[:, :, 0]
-        except np.linalg.LinAlgError:                        # skip the singular frequencies
-            us = np.zeros_like(u)
-            for i in range(ws.size):
-                try:
-                    us[i] = np.linalg.solve(A[i], u[i])
-                except np.linalg.LinAlgError:
-                    pass
-        stuck = np.max(np.abs(us), axis=0, initial=0.0)
+        nc = self.n_dof
+        free, stuck = np.zeros(nc), np.zeros(nc)
+        for w in ws:               # one frequency at a time: n_c^2 memory, not n_w n_c^2
+            H = self._builder.receptances(np.array([w]), np.arange(nc), np.arange(nc + 1))[0]
+            u = H[:, nc]                                       # (n_c,) contact response to F_e
+            free = np.maximum(free, np.abs(u))
+            try:
+                stuck = np.maximum(stuck, np.abs(np.linalg.solve(np.eye(nc) + H[:, :nc] @ Ks, u)))
+            except np.linalg.LinAlgError:                      # skip a singular frequency
+                pass
         return free, stuck
 
     # ------------------------------------------------------------------ outputs and energy
-    def _implied_forces(self, X: np.ndarray, L: _LinearPart) -> np.ndarray:
+    def _implied_forces(self, X: np.ndarray, L: LinearPart) -> np.ndarray:
         """Contact forces implied by the linear part, ``F' = F_eq - Z_c U``, per harmonic (n_h, n_c) complex."""
-        Fp = (L.F - L.J @ X.reshape(-1)).reshape(X.shape)
-        return self._complex(Fp)
+        f = self._complex(L.F.reshape(X.shape))
+        return f - (L.Z @ self._complex(X)[:, :, None])[:, :, 0]
 
-    def _respond(self, a: str, fp: np.ndarray, L: _LinearPart) -> np.ndarray:
+    def _respond(self, a: str, fp: np.ndarray, L: LinearPart) -> np.ndarray:
         """Response ``y_a = H_ae F_e - H_ac F'`` (n_coef, n_a) of coordinates ``a`` (``'e'``, ``'o'``)
         to the implied contact forces ``fp`` (n_h, n_c) complex."""
-        sa, sc, se = self._sl[a], self._sl["c"], self._sl["e"]
-        y = (L.H[:, sa, se] @ self._Fe_c[:, :, None] - L.H[:, sa, sc] @ fp[:, :, None])[:, :, 0]
+        nc, ne = self.n_dof, self._sl["e"].stop - self.n_dof
+        ra = slice(0, ne) if a == "e" else slice(ne, None)
+        Hx = L.Hx[:, ra]
+        y = (Hx[:, :, nc:] @ self._Fe_c[:, :, None] - Hx[:, :, :nc] @ fp[:, :, None])[:, :, 0]
         return self._real(y)
 
     def recover_outputs(self, X: np.ndarray, w: float) -> np.ndarray:
@@ -484,8 +436,8 @@ class CondensedHarmonicBalance:
         L = self._linear(w)
         fp = self._implied_forces(X, L)
         w_nl = np.pi * float(np.vdot(self.nonlinear_forces(X, w), self.basis.D @ X))
-        i1, e, nc = self._i1, self._sl["e"].start, self.n_dof
-        ye = L.H[i1, e, e] - L.H[i1, e, :nc] @ fp[i1]               # y_e = H_ee F_e - H_ec F'
+        i1, nc = self._i1, self.n_dof
+        ye = L.Hx[i1, 0, nc] - L.Hx[i1, 0, :nc] @ fp[i1]             # y_e = H_ee F_e - H_ec F'
         w_ex = -np.pi * float(ye.imag)
         # modal amplitudes under F_e and -F' (the mean, W = 0, does no work)
         W = self._h * w

@@ -114,7 +114,7 @@ def _invert(A, out):
 
 @nb.njit(cache=True)
 def condensed_linear(H, dH, hs, rows, nc, ie, i1):
-    """Condensed stiffness per harmonic, its real Jacobian blocks and the equivalent load.
+    """Condensed stiffness per harmonic, its frequency derivative and the equivalent load.
 
     Parameters
     ----------
@@ -136,10 +136,8 @@ def condensed_linear(H, dH, hs, rows, nc, ie, i1):
     -------
     ok : bool
         False when a contact receptance is singular.
-    Z : ndarray, complex, shape (n_h, nc, nc)
-        ``H_cc^{-1}``.
-    JJ : ndarray, shape (2, n_coef nc, n_coef nc)
-        ``J`` and ``dJ`` (module doc) on the unknown vector.
+    Z, hdZ : ndarray, complex, shape (n_h, nc, nc)
+        ``H_cc^{-1}`` and ``h dZ/dW`` per harmonic.
     FF : ndarray, shape (2, n_coef nc)
         ``F_eq`` and ``dF_eq/dw``.
     """
@@ -147,17 +145,14 @@ def condensed_linear(H, dH, hs, rows, nc, ie, i1):
     nco = 0
     for k in range(nh):
         nco += 1 if hs[k] == 0.0 else 2
-    nu = nco * nc
     Z = np.zeros((nh, nc, nc), dtype=np.complex128)
     dZ = np.zeros((nh, nc, nc), dtype=np.complex128)
-    JJ = np.zeros((2, nu, nu))
-    J, dJ = JJ[0], JJ[1]
-    FF = np.zeros((2, nu))
+    FF = np.zeros((2, nco * nc))
     F, dF = FF[0], FF[1]
     T = np.empty((nc, nc), dtype=np.complex128)
     for k in range(nh):
         if not _invert(H[k, :nc, :nc], Z[k]):
-            return False, Z, JJ, FF
+            return False, Z, dZ, FF
         for a in range(nc):                      # T = Z H'
             for b in range(nc):
                 s = 0j
@@ -170,26 +165,6 @@ def condensed_linear(H, dH, hs, rows, nc, ie, i1):
                 for q in range(nc):
                     s += T[a, q] * Z[k, q, b]
                 dZ[k, a, b] = -s
-        h = hs[k]
-        c0 = rows[k] * nc
-        if h == 0.0:
-            for a in range(nc):
-                for b in range(nc):
-                    J[c0 + a, c0 + b] = Z[k, a, b].real
-            continue
-        s0 = c0 + nc
-        for a in range(nc):
-            for b in range(nc):
-                zr, zi = Z[k, a, b].real, Z[k, a, b].imag
-                J[c0 + a, c0 + b] = zr
-                J[c0 + a, s0 + b] = zi
-                J[s0 + a, c0 + b] = -zi
-                J[s0 + a, s0 + b] = zr
-                dz = h * dZ[k, a, b]
-                dJ[c0 + a, c0 + b] = dz.real
-                dJ[c0 + a, s0 + b] = dz.imag
-                dJ[s0 + a, c0 + b] = -dz.imag
-                dJ[s0 + a, s0 + b] = dz.real
     c0 = rows[i1] * nc
     for a in range(nc):
         t = 0j
@@ -201,7 +176,9 @@ def condensed_linear(H, dH, hs, rows, nc, ie, i1):
         F[c0 + nc + a] = -t.imag
         dF[c0 + a] = dt.real
         dF[c0 + nc + a] = -dt.imag
-    return True, Z, JJ, FF
+    for k in range(nh):
+        dZ[k] *= hs[k]
+    return True, Z, dZ, FF
 
 
 @nb.njit(cache=True)
@@ -210,38 +187,68 @@ def proportional_linear(Pu, ia, ib, p, om2, c, Ru, hs, w, rows, nc, ie, i1):
 
     Returns
     -------
-    ok, H, dH, Z, JJ, FF
+    ok, H, dH, Z, hdZ, FF
     """
     H, dH = modal_receptances(Pu, ia, ib, p, om2, c, Ru, hs * w)
-    ok, Z, JJ, FF = condensed_linear(H, dH, hs, rows, nc, ie, i1)
-    return ok, H, dH, Z, JJ, FF
+    ok, Z, hdZ, FF = condensed_linear(H, dH, hs, rows, nc, ie, i1)
+    return ok, H, dH, Z, hdZ, FF
 
 
 @nb.njit(cache=True)
-def assemble(J0, dJ0, F0, dF0, x, Fn, dFn, dFw, J, R, dRw):
-    """Residual ``R = J0 x - F0 + Fn``, ``dR/dw = dJ0 x - dF0 + dFw`` and ``J = J0 + dFn``, written
-    into ``J`` (n_u, n_u), ``R`` and ``dRw`` (n_u,) (views allowed).
+def assemble(Z, hdZ, hs, rows, F0, dF0, x, Fn, dFn, dFw, J, R, dRw):
+    """Residual ``R = Z U - F0 + Fn``, ``dR/dw = h Z' U - dF0 + dFw`` and ``J = J_Z + dFn``,
+    written into ``J`` (n_u, n_u), ``R`` and ``dRw`` (n_u,) (views allowed); ``J_Z`` is ``Z`` in
+    real block form per harmonic (module doc).  No ``n_u x n_u`` matrix of the linear part is
+    formed: ``Z`` is written straight into ``J``.
 
     Parameters
     ----------
-    J0, dJ0 : ndarray, shape (n_u, n_u)
-        Linear part and its ``w``-derivative (:func:`condensed_linear`).
+    Z, hdZ : ndarray, complex, shape (n_h, n_c, n_c)
+        Condensed stiffness and ``h dZ/dW`` per harmonic.
+    hs : ndarray, shape (n_h,)
+    rows : ndarray of int, shape (n_h,)
+        Cosine (or mean) row of each harmonic; the sine row follows it.
     F0, dF0 : ndarray, shape (n_u,)
         Equivalent load and its ``w``-derivative.
     x : ndarray, shape (n_u,)
-        Unknowns.
+        Unknowns (coefficient-major: ``x[row * n_c + a]``).
     Fn, dFw : ndarray, shape (n_u,)
         Nonlinear forces and their ``w``-derivative on all unknowns.
     dFn : ndarray, shape (n_u, n_u)
         Their Jacobian.
     """
-    n = x.size
-    for i in range(n):
-        r = 0.0
-        dr = 0.0
-        for j in range(n):
-            r += J0[i, j] * x[j]
-            dr += dJ0[i, j] * x[j]
-            J[i, j] = J0[i, j] + dFn[i, j]
-        R[i] = (r - F0[i]) + Fn[i]
-        dRw[i] = (dr - dF0[i]) + dFw[i]
+    nh, nc = Z.shape[0], Z.shape[1]
+    J[:, :] = dFn
+    for i in range(x.size):
+        R[i] = Fn[i] - F0[i]
+        dRw[i] = dFw[i] - dF0[i]
+    for k in range(nh):
+        c0 = rows[k] * nc
+        if hs[k] == 0.0:
+            for a in range(nc):
+                r = 0.0
+                for b in range(nc):
+                    z = Z[k, a, b].real
+                    J[c0 + a, c0 + b] += z
+                    r += z * x[c0 + b]
+                R[c0 + a] += r
+            continue
+        s0 = c0 + nc
+        for a in range(nc):
+            rc, rs, dc, ds = 0.0, 0.0, 0.0, 0.0
+            for b in range(nc):
+                zr, zi = Z[k, a, b].real, Z[k, a, b].imag
+                J[c0 + a, c0 + b] += zr
+                J[c0 + a, s0 + b] += zi
+                J[s0 + a, c0 + b] -= zi
+                J[s0 + a, s0 + b] += zr
+                xc, xs = x[c0 + b], x[s0 + b]
+                rc += zr * xc + zi * xs
+                rs += zr * xs - zi * xc
+                dr, di = hdZ[k, a, b].real, hdZ[k, a, b].imag
+                dc += dr * xc + di * xs
+                ds += dr * xs - di * xc
+            R[c0 + a] += rc
+            R[s0 + a] += rs
+            dRw[c0 + a] += dc
+            dRw[s0 + a] += ds

@@ -28,8 +28,8 @@ ELEMENTS = [{"type": "jenkins", "dofs": [11, 10], "kt": 500.0, "slip_force": 0.3
 DAMPING = {"modal": {"modal_damping": 0.01}, "matrix": {"damping": C.tolist()}}
 
 
-def problem(damping, modes):
-    case = case_from_dict({
+def _case(damping, modes):
+    return case_from_dict({
         "model": {"mass": M.tolist(), "stiffness": K.tolist(), "solver": "condensed", "modes": modes,
                   **DAMPING[damping]},
         "element": ELEMENTS,
@@ -37,6 +37,10 @@ def problem(damping, modes):
         "analysis": {"harmonics": 3, "time_samples": 32, "frequency_hz": [0.5, 3.0],
                      "outputs": {"tip": 11, "mid": 4}},
     })
+
+
+def problem(damping, modes):
+    case = _case(damping, modes)
     p, _ = build_problem(case, FourierBasis(case.analysis.harmonics, case.analysis.time_samples), "auto")
     assert isinstance(p, CondensedHarmonicBalance)
     return p
@@ -185,3 +189,55 @@ def test_receptance_stack_matches_single_frequency(damping):
                                     np.diag(r.modal_c).copy(), Rk[ia, ib].copy(), Ws)
         assert np.abs(Hk - H).max() <= 1e-12 * np.abs(H).max()
         assert np.abs(dHk - dH).max() <= 1e-12 * np.abs(dH).max()
+
+
+def _rebuilt(case, basis, ref, strategy):
+    """``ref``'s problem with its linear part formed by ``strategy``."""
+    return CondensedHarmonicBalance(ref.reduced, case.elements, basis, case.excitation.force, ref.nl.transform,
+                                    ref.output_rows, linear_strategy=strategy)
+
+
+@pytest.mark.parametrize("damping", ["modal", "matrix"])
+@pytest.mark.parametrize("strategy", ["woodbury", "dense"])
+def test_linear_strategies_give_the_same_numbers(damping, strategy):
+    """Woodbury (R_cc positive definite with 5 of 12 modes) and dense LAPACK inverses against
+    the compiled Gauss-Jordan path: residual, Jacobians, outputs and energy balance."""
+    case = _case(damping, 5)
+    basis = FourierBasis(case.analysis.harmonics, case.analysis.time_samples)
+    ref, _ = build_problem(case, basis, "auto")
+    assert ref._builder.strategy == "compiled"
+    p = _rebuilt(case, basis, ref, strategy)
+    assert p._builder.strategy == strategy
+    X = state(ref)
+    for f_hz in (0.7, 1.9):
+        w = 2 * np.pi * f_hz
+        for a, b in zip(p.residual(X, w), ref.residual(X, w)):
+            assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max()
+        Y, Yr = p.recover_outputs(X, w), ref.recover_outputs(X, w)
+        assert np.abs(Y - Yr).max() <= 1e-10 * np.abs(Yr).max()
+        e, er = p.energy_balance(X, w), ref.energy_balance(X, w)
+        assert abs(e.excitation - er.excitation) <= 1e-10 * abs(er.excitation)
+        assert abs(e.viscous - er.viscous) <= 1e-10 * abs(er.viscous)
+    free, stuck = p.linear_peak_amplitudes(2 * np.pi * np.array([0.6, 1.4]))
+    free_r, stuck_r = ref.linear_peak_amplitudes(2 * np.pi * np.array([0.6, 1.4]))
+    assert np.allclose(free, free_r, rtol=1e-10) and np.allclose(stuck, stuck_r, rtol=1e-10)
+
+
+def test_woodbury_needs_a_positive_definite_residual_flexibility():
+    """With every mode kept the residual flexibility is zero: the Woodbury form is refused by
+    name, and the automatic choice for many contacts falls back to the dense inverse."""
+    case = _case("modal", "all")
+    basis = FourierBasis(case.analysis.harmonics, case.analysis.time_samples)
+    ref, _ = build_problem(case, basis, "auto")
+    with pytest.raises(ValueError, match="positive definite residual flexibility"):
+        _rebuilt(case, basis, ref, "woodbury")
+    from hbm.condensed_linear import LinearBuilder
+    b = ref._builder
+    auto = LinearBuilder(ref.reduced, b.phi, b.R, 4, 1, b.hs, b.rows, b.i1, "auto")
+    assert auto.strategy == "compiled"                 # 4 contacts: below the Woodbury threshold
+    import hbm.condensed_linear as cl
+    old, cl.WOODBURY_MIN_CONTACTS = cl.WOODBURY_MIN_CONTACTS, 1
+    try:
+        assert LinearBuilder(ref.reduced, b.phi, b.R, 4, 1, b.hs, b.rows, b.i1, "auto").strategy == "dense"
+    finally:
+        cl.WOODBURY_MIN_CONTACTS = old

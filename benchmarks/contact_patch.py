@@ -1,0 +1,169 @@
+"""Cost of a friction FRF against the number of contact nodes of an FE interface (not a test).
+
+Model (:mod:`fe_columns`): two clamped steel columns (8100 DOFs) meeting end to end on a
+patch of ``n_c`` node pairs, each a ``friction3d`` contact; the totals are kt = 2e7 N/m,
+kn = 4e7 N/m, normal preload 500 N, mu = 0.5, divided by ``n_c``.  20 N at the middle of
+column A (x), 0.2 % modal damping, condensed solver with 40 modes and residual flexibility.
+The window spans the first out-of-phase bending pair (interface shear).
+
+For every ``(n_c, H)`` a fresh process (so peak memory is the case's own) reports:
+unknowns, the time of one Newton iteration split into the linear part at a new frequency,
+the AFT and the dense solve, and a whole FRF (``--no-stability``; large cases stop after
+``--max-points`` points and report per point).  Writes ``benchmarks/results/contact_patch.csv``
+and ``contact_patch.png`` (log-log cost against ``n_c``).
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/contact_patch.py [--nc 1 4 16 64] [--H 3 7]
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+MODEL_DIR = Path(tempfile.gettempdir()) / "hbm_contact_patch_model"
+FIELDS = ("n_c", "H", "n_unknowns", "linear_s", "aft_s", "solve_s", "points", "iterations",
+          "frf_s", "s_per_point", "s_per_iteration", "peak_mb", "status", "peak_hz", "peak_m")
+
+
+def write_model():
+    """The column pair as Matrix Market files in a temporary folder (built once, ~2 s)."""
+    import scipy.io
+    from fe_columns import column_pair
+    stamp = MODEL_DIR / "cols_pairs.npy"
+    if stamp.is_file():
+        return
+    MODEL_DIR.mkdir(exist_ok=True)
+    cp = column_pair()
+    scipy.io.mmwrite(str(MODEL_DIR / "cols_K.mtx"), cp.K, symmetry="symmetric")
+    scipy.io.mmwrite(str(MODEL_DIR / "cols_M.mtx"), cp.M, symmetry="symmetric")
+    (MODEL_DIR / "cols_dofs.txt").write_text("\n".join(cp.dof_names) + "\n")
+    (MODEL_DIR / "cols_drive.txt").write_text(cp.drive)
+    np.save(stamp, cp.pairs)
+
+
+def case_dict(n_c: int, H: int, max_points: int) -> dict:
+    pairs = np.load(MODEL_DIR / "cols_pairs.npy")[:n_c]
+    drive = (MODEL_DIR / "cols_drive.txt").read_text().strip()
+    elements = []
+    for i, (a, b) in enumerate(pairs):
+        rel = {d: [[f"A.n{a}.{d}", 1.0], [f"B.n{b}.{d}", -1.0]] for d in "xyz"}
+        elements.append({"type": "friction3d", "name": f"c{i}", "dofs": {"t1": rel["x"], "t2": rel["y"], "n": rel["z"]},
+                         "kt": 2e7 / n_c, "kn": 4e7 / n_c, "mu": 0.5, "normal_preload": 500.0 / n_c})
+    return {"name": f"contact patch n_c={n_c}",
+            "model": {"file": str(MODEL_DIR / "cols_K.mtx"), "modal_damping": 0.002, "solver": "condensed",
+                      "modes": 40, "residual_flexibility": True},
+            "element": elements,
+            "excitation": {"dofs": [drive], "amplitude": [20.0]},
+            "analysis": {"harmonics": H, "frequency_hz": [6200.0, 8400.0], "max_points": max_points,
+                         "outputs": {"drive": drive}}}
+
+
+def _best(fn, n=3):
+    t = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        t.append(time.perf_counter() - t0)
+    return min(t)
+
+
+def measure(n_c: int, H: int, max_points: int) -> dict:
+    """One case in this process (see module doc); returns a row of :data:`FIELDS`."""
+    from hbm.case import case_from_dict
+    from hbm.fourier import FourierBasis
+    from hbm.response import build_problem, frf, resolve_settings
+    case = case_from_dict(case_dict(n_c, H, max_points), path="contact_patch")
+    h, N, lo, hi, tr = resolve_settings(case, None, None, None, None, None)
+    problem, _ = build_problem(case, FourierBasis(h, N), tr)
+    w = 2 * np.pi * 0.5 * (lo + hi)
+    X = problem.linear_solution(w, problem.stuck_stiffness())
+    problem.residual(X, w)                                   # compile
+
+    def linear():
+        problem._memo_w = None
+        problem._linear(w)
+    lin = _best(linear)
+    d = problem.nl.dofs
+    aft = _best(lambda: problem.nl.evaluate(np.ascontiguousarray(X[:, d]), w))
+    R, J, _ = problem.residual(X, w)
+    solve = _best(lambda: np.linalg.solve(J, R))
+    res = frf(case, stability=False)
+    t = res.solve_seconds
+    its = int(res.iterations.sum())
+    pts = int(res.freq_hz.size)
+    h1 = res.outputs["drive"].h1
+    k = int(np.argmax(h1)) if h1.size else 0
+    return {"n_c": n_c, "H": H, "n_unknowns": problem.n_unknowns, "linear_s": lin, "aft_s": aft,
+            "solve_s": solve, "points": pts, "iterations": its, "frf_s": t, "s_per_point": t / max(pts, 1),
+            "s_per_iteration": t / max(its, 1),
+            "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+            "status": res.status, "peak_hz": float(res.freq_hz[k]) if h1.size else float("nan"),
+            "peak_m": float(h1[k]) if h1.size else float("nan")}
+
+
+def plot(rows, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    for H in sorted({r["H"] for r in rows}):
+        rr = sorted((r for r in rows if r["H"] == H), key=lambda r: r["n_c"])
+        nc = [r["n_c"] for r in rr]
+        ax.loglog(nc, [r["s_per_iteration"] for r in rr], "o-", label=f"H = {H}: s per Newton iteration")
+        ax.loglog(nc, [r["linear_s"] for r in rr], "s--", label=f"H = {H}: linear part per frequency")
+    ax.set_xlabel("contact nodes n_c")
+    ax.set_ylabel("seconds")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("Cost against contact nodes (8100-DOF column pair)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--nc", type=int, nargs="+", default=[1, 4, 16, 64])
+    ap.add_argument("--H", type=int, nargs="+", default=[3])
+    ap.add_argument("--max-points", type=int, default=60, help="points per FRF at most")
+    ap.add_argument("--one", nargs=3, type=int, metavar=("NC", "H", "MAXPTS"), help=argparse.SUPPRESS)
+    ap.add_argument("--out", default=str(HERE / "results" / "contact_patch"))
+    args = ap.parse_args(argv)
+    write_model()
+    if args.one:
+        print(json.dumps(measure(*args.one)))
+        return
+    rows = []
+    print(" ".join(f"{f:>11}" for f in FIELDS), flush=True)
+    for H in args.H:
+        for n_c in args.nc:
+            out = subprocess.run([sys.executable, __file__, "--one", str(n_c), str(H), str(args.max_points)],
+                                 capture_output=True, text=True)
+            if out.returncode:
+                print(f"n_c={n_c} H={H} failed: {out.stderr.strip().splitlines()[-1:]}", flush=True)
+                continue
+            row = json.loads(out.stdout.strip().splitlines()[-1])
+            rows.append(row)
+            print(" ".join(f"{row[f]:>11.4g}" if isinstance(row[f], float) else f"{row[f]:>11}" for f in FIELDS),
+                  flush=True)
+    base = Path(args.out)
+    base.parent.mkdir(exist_ok=True)
+    with open(base.with_suffix(".csv"), "w", newline="") as fh:
+        wr = csv.DictWriter(fh, fieldnames=FIELDS)
+        wr.writeheader()
+        wr.writerows(rows)
+    if rows:
+        plot(rows, base.with_suffix(".png"))
+
+
+if __name__ == "__main__":
+    main()
