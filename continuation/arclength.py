@@ -53,6 +53,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
+from .linsolve import REUSE_MIN_SIZE, ReusedLU, direct_solve
 from .kernels import step_geometry
 from .options import ArclengthOptions
 from .point import ContinuationPoint
@@ -174,6 +175,8 @@ class Arclength:
         self.points: list[ContinuationPoint] = []
         self._started = False
         self._rho0: float | None = None
+        # large systems keep an LU across Newton iterations and steps (continuation.linsolve)
+        self._linear_solve = ReusedLU() if x0.size >= REUSE_MIN_SIZE else direct_solve
 
     # ------------------------------------------------------------------ evaluation
     def _evaluate(self, xs: np.ndarray) -> Evaluation:
@@ -192,7 +195,7 @@ class Arclength:
         o = self.options
         with np.errstate(all="ignore"):
             return correct(self._evaluate, xs0, constraint, self._rho0, o.tol, o.max_iter,
-                           o.max_backtrack)
+                           o.max_backtrack, linear_solve=self._linear_solve)
 
     def _fixed_lam(self, xs0: np.ndarray, lam_s: float) -> Correction:
         e = np.zeros_like(xs0)

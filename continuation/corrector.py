@@ -52,19 +52,10 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from scipy.linalg.lapack import dgesv
-
 from .kernels import bordered_system, inf_norm, scale_jacobian
+from .linsolve import direct_solve
 
 _EPS = np.finfo(float).eps
-
-
-def solve(A: np.ndarray, B: np.ndarray):
-    """``A^{-1} B`` by LU (LAPACK ``dgesv``; ``A`` is overwritten when Fortran-ordered, ``B``
-    is not), None if ``A`` is exactly singular.  ``np.linalg.solve`` costs about 20 us more
-    per call in wrapping, a sizeable part of a small problem's continuation step."""
-    _, _, x, info = dgesv(A, B, overwrite_a=True, overwrite_b=False)
-    return x if info == 0 else None
 
 
 class Evaluation:
@@ -181,7 +172,7 @@ def sphere_constraint(center: np.ndarray, radius: float) -> Constraint:
 
 def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             constraint: Constraint, rho0: float | None, tol: float, max_iter: int, max_backtrack: int,
-            stall_factor: float = 10.0, stall_window: int = 3) -> Correction:
+            stall_factor: float = 10.0, stall_window: int = 3, linear_solve=direct_solve) -> Correction:
     """Newton with backtracking on ``[R(s*xs); g(xs)] = 0`` (module doc).
 
     Parameters
@@ -209,6 +200,9 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         smallest merit of the iterates before them (at least ``2 stall_window`` iterates
         seen; 0: never): cycling at a stick-slip kink, which a shorter step resolves
         sooner than further iterations at this one.
+    linear_solve : callable
+        ``(A (n+1, n+1) Fortran-ordered, B (n+1, k)) -> A^{-1} B`` or None when singular; ``A``
+        may be overwritten (:mod:`continuation.linsolve`: direct LU or a kept LU with GMRES).
 
     Returns
     -------
@@ -246,7 +240,7 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         # module doc) from a second right-hand side
         B = np.empty((n + 1, 2), order="F") if converged else B1
         bordered_system(ev.Js, ev.R, a, rho, g, A, B)
-        sol = solve(A, B)
+        sol = linear_solve(A, B)
         d_max = math.nan if sol is None else inf_norm(sol[:, 0])
         if not math.isfinite(d_max):
             if converged:

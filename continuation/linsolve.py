@@ -1,0 +1,131 @@
+r"""Linear solves of the Newton corrector: direct LU, or GMRES on an LU kept from an earlier matrix.
+
+Every Newton update solves the bordered system :math:`A \delta = b` (:mod:`continuation.corrector`).
+Between neighbouring iterations and steps of a path :math:`A` changes little (a few contacts
+change between stick and slip), so for large systems an LU factorisation ``P L U = A_0`` of an
+earlier matrix preconditions GMRES on the current one (right preconditioning):
+
+.. math::
+
+    A M^{-1} y = b, \qquad \delta = M^{-1} y, \qquad M = A_0 ,
+
+stopped when :math:`\|b - A\delta\|_2 \le \epsilon \|b\|_2`.  Each Krylov iteration costs a
+product with :math:`A` and a triangular solve, :math:`O(n^2)`, instead of the
+:math:`O(n^3)` of a new factorisation.  When GMRES does not reach :math:`\epsilon` within
+``max_krylov`` iterations the current matrix is factored and solved directly (exact), and
+its LU becomes the new preconditioner.  An accepted point is still decided by the
+corrector's residual test on the exact residual, so a Krylov update changes at most how
+fast Newton converges, never what it converges to.
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from scipy.linalg import LinAlgWarning, lu_factor, lu_solve
+from scipy.linalg.lapack import dgesv
+
+REUSE_MIN_SIZE = 800      # below this a fresh LU is cheaper than a few Krylov iterations
+
+
+def direct_solve(A: np.ndarray, B: np.ndarray):
+    """``A^{-1} B`` by LU (LAPACK ``dgesv``; ``A`` is overwritten when Fortran-ordered, ``B``
+    is not), None if ``A`` is exactly singular.  ``np.linalg.solve`` costs about 20 us more
+    per call in wrapping, a sizeable part of a small problem's continuation step."""
+    _, _, x, info = dgesv(A, B, overwrite_a=True, overwrite_b=False)
+    return x if info == 0 else None
+
+
+class ReusedLU:
+    """Solver of ``A X = B`` that keeps an LU for later matrices (module docstring).
+
+    Parameters
+    ----------
+    rtol : float
+        Relative residual at which GMRES stops (:math:`\\epsilon`).
+    max_krylov : int
+        Krylov iterations per right-hand side before a new factorisation.
+
+    Attributes
+    ----------
+    factorisations, krylov_iterations : int
+        Counts, for benchmarks.
+    """
+
+    def __init__(self, rtol: float = 1e-7, max_krylov: int = 20):
+        self.rtol, self.max_krylov = rtol, max_krylov
+        self._lu = None
+        self.factorisations = 0
+        self.krylov_iterations = 0
+
+    def __call__(self, A: np.ndarray, B: np.ndarray):
+        """``A^{-1} B`` for ``A`` (n, n) and ``B`` (n, k); None if ``A`` is singular.  ``A`` may be
+        overwritten."""
+        if self._lu is not None and self._lu[0].shape == A.shape:
+            X = np.empty(B.shape)
+            for j in range(B.shape[1]):
+                x = self._gmres(A, B[:, j])
+                if x is None:
+                    break
+                X[:, j] = x
+            else:
+                return X
+        return self._factor(A, B)
+
+    def _factor(self, A, B):
+        try:
+            with warnings.catch_warnings():      # a singular matrix is answered by None
+                warnings.simplefilter("ignore", LinAlgWarning)
+                lu = lu_factor(A, overwrite_a=True, check_finite=False)
+        except (ValueError, np.linalg.LinAlgError):
+            return None
+        if not np.all(np.isfinite(lu[0])) or np.any(np.diag(lu[0]) == 0.0):
+            self._lu = None
+            return None
+        self._lu = lu
+        self.factorisations += 1
+        return lu_solve(lu, B, check_finite=False)
+
+    def _gmres(self, A, b):
+        """Right-preconditioned GMRES from zero; None when ``max_krylov`` iterations do not
+        reach the tolerance."""
+        beta = np.linalg.norm(b)
+        if beta == 0.0:
+            return np.zeros_like(b)
+        m = self.max_krylov
+        V = np.empty((m + 1, b.size))
+        Hh = np.zeros((m + 1, m))
+        V[0] = b / beta
+        g = np.zeros(m + 1)
+        g[0] = beta
+        cs, sn = np.zeros(m), np.zeros(m)
+        Zs = np.empty((m, b.size))
+        for k in range(m):
+            Zs[k] = lu_solve(self._lu, V[k], check_finite=False)
+            w = A @ Zs[k]
+            for i in range(k + 1):                   # modified Gram-Schmidt, twice
+                Hh[i, k] = V[i] @ w
+                w -= Hh[i, k] * V[i]
+            for i in range(k + 1):
+                c = V[i] @ w
+                Hh[i, k] += c
+                w -= c * V[i]
+            Hh[k + 1, k] = np.linalg.norm(w)
+            if Hh[k + 1, k] > 0.0:
+                V[k + 1] = w / Hh[k + 1, k]
+            for i in range(k):                       # previous Givens rotations
+                t = cs[i] * Hh[i, k] + sn[i] * Hh[i + 1, k]
+                Hh[i + 1, k] = -sn[i] * Hh[i, k] + cs[i] * Hh[i + 1, k]
+                Hh[i, k] = t
+            r = np.hypot(Hh[k, k], Hh[k + 1, k])
+            if r == 0.0:
+                return None
+            cs[k], sn[k] = Hh[k, k] / r, Hh[k + 1, k] / r
+            Hh[k, k], Hh[k + 1, k] = r, 0.0
+            g[k + 1] = -sn[k] * g[k]
+            g[k] = cs[k] * g[k]
+            self.krylov_iterations += 1
+            if abs(g[k + 1]) <= self.rtol * beta:
+                y = np.linalg.solve(np.triu(Hh[:k + 1, :k + 1]), g[:k + 1])
+                return y @ Zs[:k + 1]
+        return None
