@@ -122,6 +122,9 @@ class Arclength:
         ``lam_step(lam, direction) -> float``: the largest parameter change (unscaled, > 0)
         of a step from ``lam`` whose parameter moves in ``direction`` (+1 or -1); ``None``:
         no limit (module doc).
+    overwrite_jacobian : bool
+        ``fun`` returns a new ``J`` on every call, which the solver may scale in place (saves
+        one ``n x (n+1)`` array per evaluation on large systems).
 
     Attributes
     ----------
@@ -143,7 +146,8 @@ class Arclength:
     """
 
     def __init__(self, fun: Fun, x0, scale=None, lam_bounds=(-np.inf, np.inf),
-                 direction: int = +1, options: ArclengthOptions | None = None, lam_step=None):
+                 direction: int = +1, options: ArclengthOptions | None = None, lam_step=None,
+                 overwrite_jacobian: bool = False):
         x0 = np.array(x0, dtype=float).ravel()
         if x0.size < 2 or not np.all(np.isfinite(x0)):
             raise ValueError("x0 must be a finite vector [y, lam] with at least one unknown")
@@ -166,6 +170,7 @@ class Arclength:
         self.direction = direction
         self.options = options if options is not None else ArclengthOptions()
         self.lam_step = lam_step
+        self._overwrite = bool(overwrite_jacobian)
         self.ds0, self.ds_min, self.ds_max = self.options.step_lengths((hi - lo) / scale[-1])
         self.status = "running"
         self.message = ""
@@ -189,7 +194,7 @@ class Arclength:
         if R.shape != (n,) or J.shape != (n, n + 1):
             raise ValueError(f"fun must return R shape ({n},) and J shape ({n}, {n + 1}), "
                              f"got {R.shape} and {J.shape}")
-        return Evaluation.scaled(xs.copy(), R, J, self.scale)
+        return Evaluation.scaled(xs.copy(), R, J, self.scale, out=J if self._overwrite else None)
 
     def _correct(self, xs0, constraint) -> Correction:
         o = self.options

@@ -86,11 +86,13 @@ class Evaluation:
         self._set(xs, R, Js, scale_jacobian(R, Js, np.ones(Js.shape[1]), np.empty_like(Js)))
 
     @classmethod
-    def scaled(cls, xs: np.ndarray, R: np.ndarray, J: np.ndarray, scale: np.ndarray) -> "Evaluation":
+    def scaled(cls, xs: np.ndarray, R: np.ndarray, J: np.ndarray, scale: np.ndarray,
+               out: np.ndarray | None = None) -> "Evaluation":
         """From the unscaled Jacobian ``J`` (n, n+1): ``Js = J * scale`` and the norms in one
-        compiled pass (:func:`continuation.kernels.scale_jacobian`)."""
+        compiled pass (:func:`continuation.kernels.scale_jacobian`); ``out`` receives ``Js``
+        (may be ``J`` itself)."""
         ev = cls.__new__(cls)
-        Js = np.empty(J.shape)
+        Js = np.empty(J.shape) if out is None else out
         ev._set(xs, R, Js, scale_jacobian(R, J, scale, Js))
         return ev
 
@@ -201,8 +203,9 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         seen; 0: never): cycling at a stick-slip kink, which a shorter step resolves
         sooner than further iterations at this one.
     linear_solve : callable
-        ``(A (n+1, n+1) Fortran-ordered, B (n+1, k)) -> A^{-1} B`` or None when singular; ``A``
-        may be overwritten (:mod:`continuation.linsolve`: direct LU or a kept LU with GMRES).
+        ``(A (n+1, n+1), B (n+1, k)) -> A^{-1} B`` or None when singular; ``A`` is laid out in
+        the solver's ``order`` attribute (default ``"F"``) and may be overwritten
+        (:mod:`continuation.linsolve`: direct LU or a kept LU with GMRES).
 
     Returns
     -------
@@ -214,7 +217,8 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     if rho0 is None:
         rho0 = 1e-300
     n = ev.R.size
-    A = np.empty((n + 1, n + 1), order="F")     # refilled before every solve
+    order = getattr(linear_solve, "order", "F")
+    A = np.empty((n + 1, n + 1), order=order)   # refilled before every solve
     B1 = np.empty((n + 1, 1), order="F")
     best = (np.inf, ev, 0)
     sqrt_tol = math.sqrt(tol)

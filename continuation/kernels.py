@@ -75,9 +75,10 @@ def bordered_system(Js, R, a, rho, g, A, B):
     (the second column gives the null vector of ``Js``; module doc)."""
     n, m = Js.shape
     k = B.shape[1]
-    for j in range(m):
-        for i in range(n):
+    for i in range(n):                  # row by row: Js is C-ordered (A is either)
+        for j in range(m):
             A[i, j] = Js[i, j]
+    for j in range(m):
         A[n, j] = rho * a[j]
     for i in range(n):
         B[i, 0] = -R[i]

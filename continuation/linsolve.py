@@ -36,8 +36,15 @@ def direct_solve(A: np.ndarray, B: np.ndarray):
     return x if info == 0 else None
 
 
+direct_solve.order = "F"
+
+
 class ReusedLU:
     """Solver of ``A X = B`` that keeps an LU for later matrices (module docstring).
+
+    ``A`` may be C- or Fortran-ordered: a C-ordered ``A`` is factored as the Fortran-ordered
+    ``A^T`` it is in memory (no transposed copy) and solved with ``trans = 1``, so callers
+    fill it row by row (:attr:`order`).
 
     Parameters
     ----------
@@ -52,9 +59,12 @@ class ReusedLU:
         Counts, for benchmarks.
     """
 
+    order = "C"
+
     def __init__(self, rtol: float = 1e-7, max_krylov: int = 20):
         self.rtol, self.max_krylov = rtol, max_krylov
         self._lu = None
+        self._trans = 0
         self.factorisations = 0
         self.krylov_iterations = 0
 
@@ -73,18 +83,19 @@ class ReusedLU:
         return self._factor(A, B)
 
     def _factor(self, A, B):
+        trans = 1 if A.flags.c_contiguous and not A.flags.f_contiguous else 0
         try:
             with warnings.catch_warnings():      # a singular matrix is answered by None
                 warnings.simplefilter("ignore", LinAlgWarning)
-                lu = lu_factor(A, overwrite_a=True, check_finite=False)
+                lu = lu_factor(A.T if trans else A, overwrite_a=True, check_finite=False)
         except (ValueError, np.linalg.LinAlgError):
             return None
         if not np.all(np.isfinite(lu[0])) or np.any(np.diag(lu[0]) == 0.0):
             self._lu = None
             return None
-        self._lu = lu
+        self._lu, self._trans = lu, trans
         self.factorisations += 1
-        return lu_solve(lu, B, check_finite=False)
+        return lu_solve(lu, B, trans=trans, check_finite=False)
 
     def _gmres(self, A, b):
         """Right-preconditioned GMRES from zero; None when ``max_krylov`` iterations do not
@@ -101,7 +112,7 @@ class ReusedLU:
         cs, sn = np.zeros(m), np.zeros(m)
         Zs = np.empty((m, b.size))
         for k in range(m):
-            Zs[k] = lu_solve(self._lu, V[k], check_finite=False)
+            Zs[k] = lu_solve(self._lu, V[k], trans=self._trans, check_finite=False)
             w = A @ Zs[k]
             for i in range(k + 1):                   # modified Gram-Schmidt, twice
                 Hh[i, k] = V[i] @ w

@@ -103,7 +103,7 @@ class NonlinearForces:
             return u
         return np.hstack([u, w * (self.basis.dE @ U)])
 
-    def evaluate(self, Xnl: np.ndarray, w: float):
+    def evaluate(self, Xnl: np.ndarray, w: float, J_out: np.ndarray | None = None):
         """Forces and exact derivatives.
 
         Parameters
@@ -112,6 +112,10 @@ class NonlinearForces:
             Harmonic coefficients of the nonlinear DOFs.
         w : float
             Fundamental angular frequency, rad/s.
+        J_out : ndarray, shape (n_coef * n_nl, n_coef * n_nl), optional
+            Array (or strided view, e.g. columns of a larger matrix) to write ``dFdX`` into
+            (overwritten; returned as ``dFdX``), so that a caller's Jacobian needs no second
+            ``n_u x n_u`` array.
 
         Returns
         -------
@@ -124,7 +128,12 @@ class NonlinearForces:
         nc = self.basis.n_coef
         nn = self.n_nl
         F = np.zeros((nc, nn))
-        J4 = np.zeros((nc, nn, nc, nn))
+        if J_out is None:
+            J4 = np.zeros((nc, nn, nc, nn))
+        else:
+            s0, s1 = J_out.strides                   # a view on J_out's memory, whatever its strides
+            J4 = np.lib.stride_tricks.as_strided(J_out, (nc, nn, nc, nn), (nn * s0, s0, nn * s1, s1))
+            J4[...] = 0.0
         dFdw = np.zeros((nc, nn))
         N = self.basis.n_samples
         for e, G, parts in zip(self.elements, self._G, self._parts):
@@ -154,7 +163,7 @@ class NonlinearForces:
             dU = dFe[:, :, :-1]                                   # (nc, nl, nc * nl)
             T = np.matmul(G.T, dU)                                # (nc, nn, nc * nl)
             J4 += (T.reshape(nc * nn * nc, nl) @ G).reshape(nc, nn, nc, nn)
-        return F, J4.reshape(nc * nn, nc * nn), dFdw
+        return F, (J4.reshape(nc * nn, nc * nn) if J_out is None else J_out), dFdw
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:
         """Forces only, (n_coef, n_nl): the march runs with a single zero seed."""

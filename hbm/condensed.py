@@ -279,7 +279,8 @@ class CondensedHarmonicBalance:
         return R, J, dRw
 
     def __call__(self, x: np.ndarray):
-        """Continuation form: ``x = [U.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dU, dR/dw]`` (n_u, n_u + 1)."""
+        """Continuation form: ``x = [U.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dU, dR/dw]``
+        (n_u, n_u + 1), new arrays on every call."""
         nu = self.n_unknowns
         A = np.empty((nu, nu + 1))
         R = self._evaluate(x[:-1].reshape(self.basis.n_coef, self.n_dof), float(x[-1]), A[:, :nu], A[:, nu])
@@ -289,25 +290,33 @@ class CondensedHarmonicBalance:
         """``R`` (n_u,) returned; ``dR/dU`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw`` (n_u,)."""
         L = self._linear(w)
         x = np.ascontiguousarray(X.reshape(-1), dtype=float)
+        nu = x.size
         if not self.nl.n_nl:
-            z = np.zeros(x.size)
-            R = np.empty(x.size)
-            assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, x, z, np.zeros((x.size, x.size)), z, J, R, dRw)
+            z = np.zeros(nu)
+            J[...] = 0.0
+            R = np.empty(nu)
+            assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, x, z, z, J, R, dRw)
             return R
         d = self.nl.dofs
         Xn = np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float)
-        Fn, dFn, dFw = self.nl.evaluate(Xn, w)
+        if self._nl_all:                             # the AFT writes dF/dU straight into J
+            Fn, _, dFw = self.nl.evaluate(Xn, w, J_out=J)
+        else:
+            Fn, dFn, dFw = self.nl.evaluate(Xn, w)
+            if self._nl_all:
+                J[...] = dFn
+            else:                                    # scatter onto every contact coordinate
+                J[...] = 0.0
+                J[self._nl_ix] = dFn
         self._last_nl = (float(w), np.array(X, dtype=float), Fn)
-        if not self._nl_all:        # scatter onto every contact coordinate (zeros elsewhere)
+        if not self._nl_all:
             nco, n = X.shape
             Fa, dFa = np.zeros((nco, n)), np.zeros((nco, n))
             Fa[:, d], dFa[:, d] = Fn, dFw
-            Ja = np.zeros((nco * n, nco * n))
-            Ja[self._nl_ix] = dFn
-            Fn, dFw, dFn = Fa, dFa, Ja
-        R = np.empty(x.size)
+            Fn, dFw = Fa, dFa
+        R = np.empty(nu)
         assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, x, np.ascontiguousarray(Fn.reshape(-1)),
-                 dFn, np.ascontiguousarray(dFw.reshape(-1)), J, R, dRw)
+                 np.ascontiguousarray(dFw.reshape(-1)), J, R, dRw)
         return R
 
     def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:

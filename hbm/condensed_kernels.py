@@ -195,11 +195,11 @@ def proportional_linear(Pu, ia, ib, p, om2, c, Ru, hs, w, rows, nc, ie, i1):
 
 
 @nb.njit(cache=True)
-def assemble(Z, hdZ, hs, rows, F0, dF0, x, Fn, dFn, dFw, J, R, dRw):
-    """Residual ``R = Z U - F0 + Fn``, ``dR/dw = h Z' U - dF0 + dFw`` and ``J = J_Z + dFn``,
-    written into ``J`` (n_u, n_u), ``R`` and ``dRw`` (n_u,) (views allowed); ``J_Z`` is ``Z`` in
-    real block form per harmonic (module doc).  No ``n_u x n_u`` matrix of the linear part is
-    formed: ``Z`` is written straight into ``J``.
+def assemble(Z, hdZ, hs, rows, F0, dF0, x, Fn, dFw, J, R, dRw):
+    """Residual ``R = Z U - F0 + Fn``, ``dR/dw = h Z' U - dF0 + dFw`` and ``J += J_Z``, written
+    into ``R`` and ``dRw`` (n_u,) and added to ``J`` (n_u, n_u), which holds the nonlinear
+    forces' Jacobian on entry (views allowed); ``J_Z`` is ``Z`` in real block form per harmonic
+    (module doc).  No ``n_u x n_u`` matrix of the linear part is formed.
 
     Parameters
     ----------
@@ -214,11 +214,8 @@ def assemble(Z, hdZ, hs, rows, F0, dF0, x, Fn, dFn, dFw, J, R, dRw):
         Unknowns (coefficient-major: ``x[row * n_c + a]``).
     Fn, dFw : ndarray, shape (n_u,)
         Nonlinear forces and their ``w``-derivative on all unknowns.
-    dFn : ndarray, shape (n_u, n_u)
-        Their Jacobian.
     """
     nh, nc = Z.shape[0], Z.shape[1]
-    J[:, :] = dFn
     for i in range(x.size):
         R[i] = Fn[i] - F0[i]
         dRw[i] = dFw[i] - dF0[i]

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from continuation.linsolve import REUSE_MIN_SIZE, ReusedLU, direct_solve
+
 
 @dataclass(frozen=True)
 class NewtonResult:
@@ -28,7 +30,7 @@ class NewtonResult:
     message: str
 
 
-def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30) -> NewtonResult:
+def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_solve=None) -> NewtonResult:
     """Solve ``fun(x) = (R, J) -> R = 0``.
 
     Parameters
@@ -44,6 +46,11 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30) -> Newto
     tol : float
         Relative residual tolerance.
     max_iter : int
+    linear_solve : callable, optional
+        ``(A (n, n), B (n, 1)) -> A^{-1} B`` or None when singular (:mod:`continuation.linsolve`;
+        pass one :class:`~continuation.linsolve.ReusedLU` to many calls to keep its LU);
+        default: a direct LU, or a kept LU with GMRES for this call's iterations when
+        ``n >= REUSE_MIN_SIZE``.
 
     Returns
     -------
@@ -51,6 +58,8 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30) -> Newto
     """
     x = np.array(x0, dtype=float)
     S = np.ones_like(x) if scale is None else np.asarray(scale, dtype=float)
+    if linear_solve is None:
+        linear_solve = ReusedLU() if x.size >= REUSE_MIN_SIZE else direct_solve
     R, J = fun(x)
     r = float(np.linalg.norm(R))
     target = tol * max(r_scale, 1e-300)
@@ -59,10 +68,10 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30) -> Newto
             return NewtonResult(x, False, it - 1, np.inf, "residual is not finite")
         if r <= target:
             return NewtonResult(x, True, it - 1, r, "converged")
-        try:
-            dy = np.linalg.solve(J * S, -R)
-        except np.linalg.LinAlgError:
+        dy = linear_solve(J * S, -R[:, None])
+        if dy is None or not np.all(np.isfinite(dy)):
             return NewtonResult(x, False, it - 1, r, "singular Jacobian")
+        dy = dy[:, 0]
         alpha = 1.0
         while True:
             xt = x + alpha * S * dy

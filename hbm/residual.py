@@ -194,7 +194,8 @@ class HarmonicBalance:
         return R[:, self.fixed]
 
     def __call__(self, x: np.ndarray):
-        """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]`` (n_u, n_u + 1)."""
+        """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]``
+        (n_u, n_u + 1), new arrays on every call."""
         X = self.expand(x[:-1])
         w = float(x[-1])
         if self._all_free and self._templates is not None and (self._nl_all or not self.nl.n_nl):

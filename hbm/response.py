@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from continuation import Arclength, ArclengthOptions
+from continuation.linsolve import REUSE_MIN_SIZE, ReusedLU
 
 from .case import Case, CaseError
 from .condensed import CondensedHarmonicBalance
@@ -290,16 +291,18 @@ ENERGY_LIMIT = 1e-8
 IMPLAUSIBLE_GROWTH = 0.05
 
 
-def _polish(problem, X, w, xscale, r_scale, err):
+def _polish(problem, X, w, xscale, r_scale, err, linear_solve=None):
     """Newton at fixed ``w`` on a point whose energy balance is not closed.
 
     The continuation's tolerance is relative to the Jacobian's row norm, which a stiff
     contact (kt >> k) makes large against the excitation: such a point can be accepted with
     ``|R| / |F|`` ~ 1e-9 and an energy error ~ 1e-6.  Here the target is relative to ``|F|``.
-    Returns the better of the two points and its relative energy error.
+    Returns the better of the two points and its relative energy error.  ``linear_solve``:
+    Newton's linear solver (:func:`hbm.newton.newton`), one kept LU shared by a path's polishes.
     """
     fun = lambda u: problem.residual(problem.expand(u), w)[:2]
-    res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4)
+    res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4,
+                 linear_solve=linear_solve)
     if np.all(np.isfinite(res.x)):
         Xp = problem.expand(res.x)
         err_p = energy_balance(problem, Xp, w).relative_error
@@ -337,13 +340,14 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     """
     scale = np.r_[xscale, bounds[1] - bounds[0]]
     solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
-                       direction=direction, options=opts, lam_step=lam_step)
+                       direction=direction, options=opts, lam_step=lam_step, overwrite_jacobian=True)
+    polish_solve = ReusedLU() if problem.n_unknowns >= REUSE_MIN_SIZE else None
     for pt in solver:
         X = problem.expand(pt.x[:-1])
         w = float(pt.x[-1])
         err = energy_balance(problem, X, w).relative_error
         if err > POLISH_ENERGY:
-            X, err = _polish(problem, X, w, xscale, r_scale, err)
+            X, err = _polish(problem, X, w, xscale, r_scale, err, polish_solve)
         if err > ENERGY_LIMIT:
             return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
                     f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "

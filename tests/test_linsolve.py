@@ -49,3 +49,14 @@ def test_frf_with_kept_lu_equals_direct_path(monkeypatch):
     assert np.abs(new.freq_hz - ref.freq_hz).max() <= 1e-8 * ref.freq_hz.max()
     a, b = new.outputs["tip"].h1, ref.outputs["tip"].h1
     assert np.abs(a - b).max() <= 1e-8 * b.max()
+
+
+def test_row_ordered_matrix_is_factored_as_its_transpose_without_a_copy():
+    A, B = _matrix(40, 2)
+    Ac = np.ascontiguousarray(A)
+    s = ReusedLU(rtol=1e-12)
+    X = s(Ac.copy(), B)
+    assert s._trans == 1 and np.abs(A @ X - B).max() <= 1e-10 * np.abs(B).max()
+    A2 = A + 0.01 * np.random.default_rng(3).normal(size=A.shape)
+    X2 = s(np.ascontiguousarray(A2), B)                   # Krylov on the kept transposed LU
+    assert s.factorisations == 1 and np.abs(A2 @ X2 - B).max() <= 1e-9 * np.abs(B).max()
