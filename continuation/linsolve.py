@@ -69,8 +69,8 @@ class ReusedLU:
         self.krylov_iterations = 0
 
     def __call__(self, A: np.ndarray, B: np.ndarray):
-        """``A^{-1} B`` for ``A`` (n, n) and ``B`` (n, k); None if ``A`` is singular.  ``A`` may be
-        overwritten."""
+        """``A^{-1} B`` for ``A`` (n, n) and ``B`` (n, k); None if ``A`` is singular.  ``A`` is not
+        changed: the kept LU is a copy, since callers refill ``A`` for the next iteration."""
         if self._lu is not None and self._lu[0].shape == A.shape:
             X = np.empty(B.shape)
             for j in range(B.shape[1]):
@@ -87,7 +87,7 @@ class ReusedLU:
         try:
             with warnings.catch_warnings():      # a singular matrix is answered by None
                 warnings.simplefilter("ignore", LinAlgWarning)
-                lu = lu_factor(A.T if trans else A, overwrite_a=True, check_finite=False)
+                lu = lu_factor(A.T if trans else A, overwrite_a=False, check_finite=False)
         except (ValueError, np.linalg.LinAlgError):
             return None
         if not np.all(np.isfinite(lu[0])) or np.any(np.diag(lu[0]) == 0.0):

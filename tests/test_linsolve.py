@@ -60,3 +60,16 @@ def test_row_ordered_matrix_is_factored_as_its_transpose_without_a_copy():
     A2 = A + 0.01 * np.random.default_rng(3).normal(size=A.shape)
     X2 = s(np.ascontiguousarray(A2), B)                   # Krylov on the kept transposed LU
     assert s.factorisations == 1 and np.abs(A2 @ X2 - B).max() <= 1e-9 * np.abs(B).max()
+
+
+def test_kept_lu_survives_the_caller_refilling_its_matrix():
+    """The corrector refills one array for every Newton iteration: the kept LU must not live
+    in it (else the next Krylov solve is preconditioned by garbage and refactors)."""
+    A, B = _matrix(50, 4)
+    s = ReusedLU(rtol=1e-12)
+    buf = np.array(A, order="C")
+    s(buf, B)
+    buf[...] = A + 1e-3 * np.random.default_rng(5).normal(size=A.shape)
+    X = s(buf, B)
+    assert s.factorisations == 1 and s.krylov_iterations <= 12       # two right-hand sides
+    assert np.abs(buf @ X - B).max() <= 1e-9 * np.abs(B).max()
