@@ -55,12 +55,16 @@ class NonlinearForces:
     ----------
     dofs : ndarray of int, shape (n_nl,)
         The DOFs touched by any element.
+    last_unclosed : int
+        Law parts whose hysteresis loop did not close within ``max_passes`` periods in the
+        last :meth:`evaluate` or :meth:`forces` call (their forces carry the closure error).
     """
 
     def __init__(self, basis, elements, n_dof, transform):
         self.basis = basis
         self.elements = tuple(elements)
         self.transform = transform
+        self.last_unclosed = 0
         used = np.zeros(n_dof, dtype=bool)
         for e in self.elements:
             if e.gather.shape[1] != n_dof:
@@ -136,10 +140,11 @@ class NonlinearForces:
             J4[...] = 0.0
         dFdw = np.zeros((nc, nn))
         N = self.basis.n_samples
+        unclosed = 0
         for e, G, parts in zip(self.elements, self._G, self._parts):
             if parts is not None:
                 for Gp, sp in parts:
-                    aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw)
+                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw) < 0
                 continue
             nl = e.n_local
             U = Xnl @ G.T
@@ -163,20 +168,23 @@ class NonlinearForces:
             dU = dFe[:, :, :-1]                                   # (nc, nl, nc * nl)
             T = np.matmul(G.T, dU)                                # (nc, nn, nc * nl)
             J4 += (T.reshape(nc * nn * nc, nl) @ G).reshape(nc, nn, nc, nn)
+        self.last_unclosed = int(unclosed)
         return F, (J4.reshape(nc * nn, nc * nn) if J_out is None else J_out), dFdw
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:
         """Forces only, (n_coef, n_nl): the march runs with a single zero seed."""
         Xnl = np.ascontiguousarray(Xnl, dtype=float)
         F = np.zeros((self.basis.n_coef, self.n_nl))
+        unclosed = 0
         for i, parts in enumerate(self._parts):
             if parts is not None:
                 for Gp, sp in parts:
-                    aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F)
+                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F) < 0
                 continue
             z = self.element_samples(Xnl, w, i)
             f, _ = self.elements[i].march(z, np.zeros(z.shape + (1,)))
             F += self.transform.analyse(f) @ self._G[i]
+        self.last_unclosed = int(unclosed)
         return F
 
     def element_forces(self, Xnl: np.ndarray, w: float):

@@ -150,8 +150,9 @@ def cmd_frf(args) -> int:
                 after = "no stable branch" if j["amplitude_after"] is None else f"{j['amplitude_after']:.6g}"
                 print(f"  jump {name} (sweep {way}) at {j['from_hz']:.6g} Hz: "
                       f"{j['amplitude_before']:.6g} -> {after}")
-    if st.get("stability_warning"):
-        print(f"  warning: {st['stability_warning']}", file=sys.stderr)
+    for key in ("stability_warning", "closure_warning"):
+        if st.get(key):
+            print(f"  warning: {st[key]}", file=sys.stderr)
     if summary["max_energy_error"] is not None:
         print(f"  max energy-balance error {summary['max_energy_error']:.2e}")
     print(f"  wrote {args.out}/frf.csv, frf.png, summary.json")

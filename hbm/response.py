@@ -311,14 +311,25 @@ def _polish(problem, X, w, xscale, r_scale, err, linear_solve=None):
     return X, err
 
 
+def _closure_warning(settings, unclosed, ws):
+    """``settings["closure_warning"]`` when a point's element loops did not all close."""
+    bad = [i for i, n in enumerate(unclosed) if n]
+    settings["unclosed_loop_points"] = len(bad)
+    if bad:
+        settings["closure_warning"] = (
+            f"at {len(bad)} of {len(ws)} points (first {ws[bad[0]] / (2 * np.pi):.6g} Hz) the hysteresis "
+            f"loop of up to {max(unclosed)} contact(s) did not close within the element's max_passes "
+            f"periods: their forces carry the closure error (a contact slipping very little per cycle)")
+
+
 class _Path:
     """Converged points of a traced path: coefficients, frequencies, outputs, iterations, errors."""
 
     def __init__(self):
-        self.X, self.w, self.Y, self.its, self.err = [], [], [], [], []
+        self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
 
     def extend_reversed(self, other: "_Path") -> None:
-        for name in ("X", "w", "Y", "its", "err"):
+        for name in ("X", "w", "Y", "its", "err", "unclosed"):
             getattr(self, name).extend(getattr(other, name)[::-1])
 
 
@@ -358,6 +369,7 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
         pts.Y.append(recover_outputs(problem, case, X, w))
         pts.its.append(pt.iterations if pts.w[1:] else it0 + pt.iterations)
         pts.err.append(err)
+        pts.unclosed.append(problem.nl.last_unclosed)    # of the energy balance's force call at X
         if progress is not None:
             progress(offset + len(pts.w), w / (2 * np.pi))
         if offset + len(pts.w) >= case.analysis.max_points:
@@ -447,6 +459,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
             message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[-1] / (2 * np.pi):.6g} Hz"
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
+    _closure_warning(settings, pts.unclosed, pts.w)
     stable = None
     if stability:
         stable, margin = _path_verdicts(problem, pts_X, np.array(pts_w), segments, stability_options)
