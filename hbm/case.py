@@ -150,6 +150,8 @@ def _check_keys(table, allowed, where, path):
 def _matrix(value, name, path):
     try:
         A = np.array(value, dtype=float)
+        if any(isinstance(v, bool) for v in np.array(value, dtype=object).ravel()):
+            raise ValueError("booleans")       # float() would turn true into 1.0
     except (TypeError, ValueError):
         raise CaseError(f"{path}: [model] {name} must be a matrix of numbers") from None
     if A.ndim == 0:

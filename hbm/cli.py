@@ -219,6 +219,9 @@ def cmd_timesim(args) -> int:
         sys.stderr.write(f"hbm: timesim: no periodic steady state within {opts.max_periods} periods "
                          f"(last relative change {max(res.coarse.change, res.fine.change):.2e} > tol {opts.tol:g}); "
                          f"results are of the last period\n")
+        return 1
+    return 0
+
 
 def _sweep_progress(done, total, failed):
     sys.stderr.write(f"\r  sweep: {done}/{total} done" + (f", {failed} failed" if failed else "") + " ")

@@ -60,6 +60,8 @@ class ModelData:
     dof_names: tuple = ()
 
     def __post_init__(self):
+        if getattr(self.M, "ndim", 0) != 2:
+            raise ValueError(f"mass matrix has shape {getattr(self.M, 'shape', ())}, expected a square matrix")
         n = self.M.shape[0]
         for name, A in (("mass", self.M), ("stiffness", self.K), ("damping", self.C)):
             if A is None:
@@ -91,13 +93,32 @@ def _names(arr):
     return tuple(str(s) for s in np.asarray(arr).ravel())
 
 
+def _real(A, name, path):
+    """``A`` as a float array or sparse matrix; complex, boolean or non-numeric entries are
+    refused by name (a cast would drop the imaginary part or turn ``True`` into 1.0 silently)."""
+    kind = A.dtype.kind
+    if kind == "c":
+        raise ValueError(f"{path}: {name} is complex; only real matrices are supported")
+    if kind == "b":
+        raise ValueError(f"{path}: {name} holds booleans, not numbers")
+    if kind not in "fiu":
+        raise ValueError(f"{path}: {name} holds {A.dtype} values, not numbers")
+    return A.astype(float) if sp.issparse(A) else np.asarray(A, dtype=float)
+
+
 def read_npz(path) -> ModelData:
     """Read ``M``, ``K``, optional ``C`` and ``dof_names`` from an ``.npz`` file (arrays named
     ``meta_*`` are ignored; any other array is an error naming it)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"model file not found: {path}")
-    with np.load(path, allow_pickle=False) as z:
+    try:
+        z = np.load(path, allow_pickle=False)
+    except (ValueError, OSError) as exc:
+        raise ValueError(f"{path}: not a readable .npz file ({exc})") from None
+    if not isinstance(z, np.lib.npyio.NpzFile):
+        raise ValueError(f"{path}: a single array (.npy), not an .npz archive with M and K")
+    with z:
         for key in ("M", "K"):
             if key not in z:
                 raise ValueError(f"{path}: missing array {key!r} (needs M and K)")
@@ -106,9 +127,9 @@ def read_npz(path) -> ModelData:
         unknown = {k for k in z.files if not k.startswith("meta_")} - {"M", "K", "C", "dof_names"}
         if unknown:
             raise ValueError(f"{path}: unknown array(s) {sorted(unknown)}")
-        C = np.asarray(z["C"], dtype=float) if "C" in z else None
+        C = _real(z["C"], "C", path) if "C" in z else None
         names = _names(z["dof_names"]) if "dof_names" in z else ()
-        return ModelData(np.asarray(z["M"], dtype=float), np.asarray(z["K"], dtype=float), C, names)
+        return ModelData(_real(z["M"], "M", path), _real(z["K"], "K", path), C, names)
 
 
 def _mm(path):
@@ -119,11 +140,12 @@ def _mm(path):
         A = scipy.io.mmread(str(path))
     except Exception as exc:  # scipy raises several types on malformed files
         raise ValueError(f"{path}: not a readable Matrix Market file ({exc})") from None
+    A = _real(A, "the matrix", path)
     if sp.issparse(A):
-        A = sp.csr_matrix(A, dtype=float)
+        A = sp.csr_matrix(A)
         if A.shape[0] <= 2000:
             A = A.toarray()
-    return A if sp.issparse(A) else np.asarray(A, dtype=float)
+    return A
 
 
 def read_matrix_market(path=None, *, mass_file=None, stiffness_file=None, damping_file=None,

@@ -232,6 +232,18 @@ def test_cli_writes_files(tmp_path):
     assert len(list(csv.reader(open(out / "history.csv")))) == 2 + 5 * 64
 
 
+def test_cli_no_steady_state_exits_1_and_keeps_the_files(tmp_path):
+    """Two periods cannot reach the periodicity tolerance from rest: stated on stderr, the
+    last period written, exit status 1 (a solver failure), not 0."""
+    case = tmp_path / "case.toml"
+    case.write_text(CASE)
+    out = tmp_path / "out"
+    r = run("timesim", str(case), "--freq-hz", "0.2", "-o", str(out), "--steps", "32", "--max-periods", "2")
+    assert r.returncode == 1, (r.returncode, r.stderr)
+    assert "no periodic steady state within 2 periods" in r.stderr
+    assert (out / "timesim.csv").is_file()
+
+
 @pytest.mark.parametrize("args, needle", [
     (["--freq-hz", "-1"], "freq"),
     (["--freq-hz", "0"], "freq"),
