@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import tempfile
 
 from .case import CaseError, load_case
 
@@ -110,8 +111,16 @@ def _progress(n, f):
 
 
 def _check_outdir(path):
+    """Create the output folder and write a probe file in it before any solving, so that a
+    folder that cannot hold the results is refused in one line instead of after the run."""
     if os.path.exists(path) and not os.path.isdir(path):
         raise CaseError(f"-o {path}: exists and is not a folder")
+    try:
+        os.makedirs(path, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise CaseError(f"-o {path}: cannot write results there ({exc.strerror or exc})") from None
 
 
 def _defaults_note(st) -> str:
@@ -181,6 +190,7 @@ def cmd_timesim(args) -> int:
     opts = dataclasses.replace(TimeSimOptions(), **over)
     opts.validate()
     case = load_case(args.case)
+    _check_outdir(args.out)
     t_start = time.perf_counter()
     shown = [False]
 

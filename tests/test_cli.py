@@ -81,3 +81,18 @@ def test_missing_file_and_bad_option(tmp_path):
     assert r.returncode == 2 and "not found" in r.stderr and len(r.stderr.strip().splitlines()) == 1
     r = run("frf", write(tmp_path, GOOD), "--harmonics", "x")
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("sub", ["frf", "timesim"])
+def test_unusable_output_folder_is_refused_before_solving(tmp_path, sub):
+    """An output folder under a file, or in a read-only place, is one line and exit 2 before
+    any computation (before, frf and timesim failed with a traceback after the run)."""
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    extra = ["--freq-hz", "30"] if sub == "timesim" else []
+    for out in (blocker / "out", "/proc/hbm_out"):
+        r = subprocess.run([sys.executable, "-m", "hbm", sub, "rigs/sdof_jenkins.toml", "-o", str(out), *extra],
+                           capture_output=True, text=True)
+        assert r.returncode == 2, (r.returncode, r.stderr)
+        lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+        assert len(lines) == 1 and "cannot write results" in lines[0] and "Traceback" not in r.stderr
