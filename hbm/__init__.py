@@ -7,6 +7,8 @@
 """
 from .case import Case, CaseError, load_case
 
+__version__ = "0.2.0"
+
 
 def frf(case, harmonics=None, samples=None, fmin=None, fmax=None, **kwargs):
     """Trace the FRF of a case; see :func:`hbm.response.frf`."""
@@ -20,4 +22,4 @@ def timesim(case, freq_hz, options=None, **kwargs):
     return _timesim(case, freq_hz, options, **kwargs)
 
 
-__all__ = ["Case", "CaseError", "load_case", "frf", "timesim"]
+__all__ = ["__version__", "Case", "CaseError", "load_case", "frf", "timesim"]

@@ -4,7 +4,8 @@
 [--no-stability]``;
 ``hbm timesim CASE.toml --freq-hz F -o OUTDIR [--steps N] [--tol T] [--max-periods P]
 [--periods P --switch-off-at S] [--alpha A]``;
-``hbm sweep CASE.toml (--set KEY=V1,V2,... | --force-ratio R1,R2,...) -o OUTDIR [--jobs N]``.
+``hbm sweep CASE.toml (--set KEY=V1,V2,... | --force-ratio R1,R2,...) -o OUTDIR [--jobs N]``;
+``hbm rigs`` (the shipped case files); ``hbm --version``.
 
 Thin: parse, load the case, call the library, write results.  Bad input prints one line on
 stderr and exits with status 2; a solver failure keeps the points computed and exits 1.
@@ -63,8 +64,11 @@ def _add_analysis_options(p):
 
 
 def build_parser():
+    from . import __version__
     p = _Parser(prog="hbm", description="Harmonic balance for friction-damped structures")
+    p.add_argument("--version", action="version", version=f"hbm-friction {__version__}")
     sub = p.add_subparsers(dest="command", parser_class=_Parser)
+    sub.add_parser("rigs", help="list the shipped rigs (case files) with their paths")
     f = sub.add_parser("frf", help="trace a frequency response curve")
     f.add_argument("case", help="case file (TOML)")
     f.add_argument("-o", "--out", default="out", help="output folder (default: out)")
@@ -274,7 +278,19 @@ def cmd_sweep(args) -> int:
     return 0
 
 
-COMMANDS = {"frf": cmd_frf, "timesim": cmd_timesim, "sweep": cmd_sweep}
+def cmd_rigs(args) -> int:
+    """Print each shipped case file's path and name, so a rig can be run from anywhere."""
+    import pathlib
+    import tomllib
+    import rigs
+    for path in sorted(pathlib.Path(rigs.__file__).parent.glob("*.toml")):
+        with open(path, "rb") as fh:
+            name = tomllib.load(fh).get("name", path.stem)
+        print(f"{path}  {name}")
+    return 0
+
+
+COMMANDS = {"frf": cmd_frf, "timesim": cmd_timesim, "sweep": cmd_sweep, "rigs": cmd_rigs}
 
 
 def main(argv=None) -> int:

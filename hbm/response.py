@@ -32,7 +32,7 @@ from .resonances import ResonanceStepLimit, linear_resonances
 from .stability import HillSystem, StabilityOptions, point_is_stable
 from .stability_path import hill_margin, path_stability
 from .structure import AUTO_CONDENSE_DOF
-from .transforms import make_transform
+from .transforms import fftw_available, make_transform
 
 
 @dataclass(frozen=True)
@@ -123,6 +123,9 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
     if not (lo > 0 and hi > lo):
         raise CaseError(f"frequency range is empty or not positive ({lo} .. {hi} Hz)")
     tr = transform or a.transform
+    if tr == "fftw" and not fftw_available():
+        raise CaseError("transform 'fftw' needs pyFFTW, which is not installed: "
+                        "pip install 'hbm-friction[fftw]', or choose transform = 'numpy' or 'auto'")
     return h, N, lo, hi, tr
 
 

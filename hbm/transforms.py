@@ -90,7 +90,9 @@ class FFTWTransform(_RealFFT):
 
     def __init__(self, basis: FourierBasis):
         super().__init__(basis)
-        import pyfftw  # noqa: F401  (fails early if the backend is missing)
+        if not fftw_available():
+            raise ValueError("transform 'fftw' needs pyFFTW: pip install 'hbm-friction[fftw]' "
+                             "(or choose transform = 'numpy')")
         self._plans = {}
 
     def _plan(self, direction: str, m: int):
