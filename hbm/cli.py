@@ -255,7 +255,7 @@ def cmd_sweep(args) -> int:
     overrides = FRFOverrides(args.harmonics, args.samples, args.fmin, args.fmax, args.transform)
     from .response import resolve_settings
     resolve_settings(case, args.harmonics, args.samples, args.fmin, args.fmax, args.transform)
-    opts = SweepOptions(jobs=args.jobs, dask=args.dask, resume=args.resume)
+    opts = SweepOptions(jobs=args.jobs, dask=args.dask, resume=args.resume, log_axis=args.log)
     res = sweep(case, key, values, args.out, ratio_key=args.ratio_key, overrides=overrides, options=opts,
                 progress=None if args.quiet else _sweep_progress)
     if not args.quiet:
@@ -263,14 +263,16 @@ def cmd_sweep(args) -> int:
     outputs = list(case.analysis.outputs)
     print(f"{case.name}: sweep of {key} over {len(res.rows)} values, {res.n_failed} failed")
     for r in res.rows:
-        pk = "  ".join(f"{n} peak {r['peak'][n]['amplitude']:.6g} at {r['peak'][n]['freq_hz']:.6g} Hz"
-                       for n in outputs if n in r["peak"])
+        pk = "  ".join(f"{n} peak {p['amplitude']:.6g} at {p['freq_hz']:.6g} Hz (receptance {p['receptance']:.4g})"
+                       for n in outputs if (p := r["peak"].get(n)))
         print(f"  {r['value']:>12.6g}  {r['status']:<9} {pk}" + (f"  ({r['message']})" if r["status"] != "finished" else ""))
     from .sweep import optimum
     for n in outputs:
         best = optimum(res.rows, n)
         if best is not None:
-            print(f"  optimum for {n}: {key} = {best['value']} (peak {best['peak'][n]['amplitude']:.6g})")
+            p = best["peak"][n]
+            print(f"  optimum for {n} (smallest peak receptance = peak / force): {key} = {best['value']:.6g} "
+                  f"(receptance {p['receptance']:.4g}, peak {p['amplitude']:.6g} under force {p['force']:.6g})")
     print(f"  wrote {args.out}/summary.csv, sweep.png, runs/")
     if not res.ok:
         sys.stderr.write(f"hbm: {res.n_failed} of {len(res.rows)} FRFs failed (see {args.out}/summary.csv)\n")

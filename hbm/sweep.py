@@ -15,11 +15,10 @@ with :math:`c` the value of a named case key (a wedge damper's ``cf``, or e.g. a
 Per value the FRF is written at once to ``OUTDIR/runs/<index>_<value>/`` (``frf.csv``, then
 ``summary.json`` atomically, last, which marks the run finished; it carries a fingerprint of
 the changed case and settings, so ``resume`` reuses a finished run only when it matches).
-``OUTDIR/summary.csv`` has one row per value: ``index, value, status, reused`` then per
-output ``NAME_peak`` (largest first-harmonic amplitude on the path), ``NAME_peak_freq_hz``,
-``NAME_peak_max`` (largest max |x|), then ``n_points, solve_seconds, message``.
-``OUTDIR/sweep.png`` plots peak amplitude and its frequency against the value and marks the
-minimum peak (the optimum of a friction damper).
+``OUTDIR/summary.csv`` has one row per value with each output's peak and peak receptance
+(:mod:`hbm.sweep_summary`); ``OUTDIR/sweep.png`` overlays the FRFs and plots the peak
+receptance and its frequency against the value, the smallest peak receptance (the optimum of
+a friction damper) starred (:mod:`hbm.sweep_plot`).
 
 Runs go to a local process pool (``jobs`` workers) or a Dask cluster (``dask`` = scheduler
 address; dask is imported only then).  Workers only compute; all files are written by the
@@ -28,13 +27,9 @@ the worker) is recorded with its message and the sweep goes on.
 """
 from __future__ import annotations
 
-import csv
 import hashlib
-import io
 import json
-import math
 import os
-import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field, asdict
 from pathlib import Path
@@ -43,6 +38,12 @@ import numpy as np
 
 from .case import Case, CaseError, case_from_dict, load_case
 from .casekeys import find_ratio_key, get_key, scale_excitation, set_key
+from .sweep_plot import write_plot
+from .sweep_values import parse_assignment, parse_values, value_label
+from .sweep_summary import excitation_scale, optimum, run_peaks, write_summary_csv
+
+__all__ = ["FORCE_RATIO", "FRFOverrides", "SweepOptions", "SweepResult", "sweep", "optimum",
+           "parse_values", "parse_assignment", "make_tasks", "run_task"]
 
 FORCE_RATIO = "force_ratio"
 
@@ -72,12 +73,15 @@ class SweepOptions:
         Reuse finished runs found in ``OUTDIR/runs`` whose fingerprint matches.
     plot : bool
         Write ``sweep.png``.
+    log_axis : bool
+        Draw the swept value on a log axis (also done when the values span 100x or more).
     """
 
     jobs: int | None = None
     dask: str | None = None
     resume: bool = False
     plot: bool = True
+    log_axis: bool = False
 
 
 @dataclass(frozen=True)
@@ -112,73 +116,6 @@ class SweepResult:
         return sum(r["status"] != "finished" for r in self.rows)
 
 
-# ---------------------------------------------------------------------------- values
-
-def _number(text: str, what: str):
-    t = text.strip()
-    try:
-        v = int(t)
-    except ValueError:
-        try:
-            v = float(t)
-        except ValueError:
-            raise CaseError(f"{what}: {t!r} is not a number") from None
-    if not math.isfinite(v):
-        raise CaseError(f"{what}: {t!r} is not a finite number")
-    return v
-
-
-def parse_values(text: str, log: bool = False, what: str = "--set") -> list:
-    """Values from ``"V1,V2,..."`` or ``"start:stop:count"`` (linear; geometric with ``log``).
-
-    Returns
-    -------
-    list of int or float
-        Integers stay integers in a comma list (``harmonics``, ``time_samples``).
-    """
-    text = (text or "").strip()
-    if not text:
-        raise CaseError(f"{what}: empty value list")
-    if ":" in text:
-        bits = text.split(":")
-        if len(bits) != 3:
-            raise CaseError(f"{what}: a range is start:stop:count, got {text!r}")
-        a, b = (float(_number(x, what)) for x in bits[:2])
-        n = _number(bits[2], what)
-        if not isinstance(n, int) or n < 1:
-            raise CaseError(f"{what}: range count must be a positive integer, got {bits[2].strip()!r}")
-        if log:
-            if not (a > 0 and b > 0):
-                raise CaseError(f"{what}: --log needs start and stop > 0, got {a:g}:{b:g}")
-            vals = np.geomspace(a, b, n) if n > 1 else np.array([a])
-        else:
-            vals = np.linspace(a, b, n) if n > 1 else np.array([a])
-        return [float(v) for v in vals]
-    if log:
-        raise CaseError(f"{what}: --log applies to a range start:stop:count, not to a list")
-    items = text.split(",")
-    if any(not s.strip() for s in items):
-        raise CaseError(f"{what}: empty entry in the value list {text!r}")
-    return [_number(s, what) for s in items]
-
-
-def parse_assignment(text: str, log: bool = False):
-    """``"KEY=VALUES"`` -> ``(key, values)``."""
-    if "=" not in (text or ""):
-        raise CaseError(f"--set needs KEY=VALUES (e.g. element.0.slip_force=0.5,1,2), got {text!r}")
-    key, vals = text.split("=", 1)
-    key = key.strip()
-    if not key:
-        raise CaseError(f"--set needs KEY=VALUES, got {text!r}")
-    return key, parse_values(vals, log, f"--set {key}")
-
-
-def value_label(v) -> str:
-    """Folder-safe short label of a value."""
-    s = f"{v:.6g}" if isinstance(v, float) else str(v)
-    return s.replace("+", "").replace("/", "_")
-
-
 # ---------------------------------------------------------------------------- tasks
 
 def _source(case):
@@ -192,7 +129,10 @@ def _source(case):
 
 
 def _fingerprint(raw: dict, overrides: FRFOverrides) -> str:
-    text = json.dumps({"case": raw, "overrides": asdict(overrides)}, sort_keys=True, default=str)
+    from . import __version__
+    # the version is part of it: a finished run of another version is not reused
+    text = json.dumps({"case": raw, "overrides": asdict(overrides), "version": __version__},
+                      sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
@@ -233,16 +173,6 @@ def make_tasks(case, key: str, values, overrides: FRFOverrides = FRFOverrides(),
 
 # ---------------------------------------------------------------------------- one run
 
-def _peaks(res) -> dict:
-    out = {}
-    for name, o in res.outputs.items():
-        if o.h1.size:
-            i = int(np.argmax(o.h1))
-            out[name] = {"amplitude": float(o.h1[i]), "freq_hz": float(res.freq_hz[i]),
-                         "max": float(np.max(o.max))}
-    return out
-
-
 def run_task(task: RunTask) -> dict:
     """Trace one FRF (in a worker).  Never raises: failures come back with ``status='failed'``.
 
@@ -268,7 +198,8 @@ def run_task(task: RunTask) -> dict:
     finite = all(np.all(np.isfinite(s.h1)) and np.all(np.isfinite(s.max)) for s in res.outputs.values())
     if not finite:
         status, message = "failed", "non-finite amplitudes in the response; " + message
-    summary = summary_dict(case, res, {"sweep": {**sweep_info, "peak": _peaks(res) if status == "finished" else {}}})
+    summary = summary_dict(case, res, {"sweep": {**sweep_info,
+                                                 "peak": run_peaks(res, excitation_scale(case)) if status == "finished" else {}}})
     summary["status"], summary["message"] = status, message
     return {"csv": format_csv(res), "summary": summary}
 
@@ -304,65 +235,6 @@ def finished_run(rundir: Path, task: RunTask) -> dict | None:
         return s if s["sweep"]["fingerprint"] == task.fingerprint else None
     except (OSError, ValueError, KeyError, TypeError):
         return None
-
-
-# ---------------------------------------------------------------------------- summary files
-
-def write_summary_csv(path: Path, rows: list, outputs: list) -> None:
-    """``summary.csv`` (see the module doc); rows in value order."""
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["index", "value", "status", "reused"]
-               + [f"{n}_{k}" for n in outputs for k in ("peak", "peak_freq_hz", "peak_max")]
-               + ["n_points", "solve_seconds", "message"])
-    for r in sorted(rows, key=lambda r: r["index"]):
-        cells = [r["index"], r["value"], r["status"], r["reused"]]
-        for n in outputs:
-            p = r["peak"].get(n)
-            cells += [f"{p['amplitude']:.10g}", f"{p['freq_hz']:.10g}", f"{p['max']:.10g}"] if p else ["", "", ""]
-        cells += [r["n_points"], f"{r['solve_seconds']:.4g}", r["message"]]
-        w.writerow(cells)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(buf.getvalue())
-    os.replace(tmp, path)
-
-
-def optimum(rows: list, output: str) -> dict | None:
-    """The finished row with the smallest peak amplitude of ``output`` (None if none)."""
-    ok = [r for r in rows if r["status"] == "finished" and output in r["peak"]]
-    return min(ok, key=lambda r: r["peak"][output]["amplitude"]) if ok else None
-
-
-def write_plot(path: Path, rows: list, outputs: list, xlabel: str, log: bool) -> None:
-    """``sweep.png``: peak amplitude and peak frequency against the swept value."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    rows = sorted(rows, key=lambda r: r["index"])
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True)
-    for name in outputs:
-        ok = [r for r in rows if r["status"] == "finished" and name in r["peak"]]
-        x = [r["value"] for r in ok]
-        line, = ax1.plot(x, [r["peak"][name]["amplitude"] for r in ok], "o-", label=name)
-        ax2.plot(x, [r["peak"][name]["freq_hz"] for r in ok], "o-", color=line.get_color(), label=name)
-        best = optimum(rows, name)
-        if best is not None:
-            ax1.plot([best["value"]], [best["peak"][name]["amplitude"]], "*", ms=16, color=line.get_color(),
-                     mec="k", label=f"{name} optimum: {best['value']:.4g}")
-    failed = [r["value"] for r in rows if r["status"] != "finished"]
-    for v in failed:
-        ax1.axvline(v, color="r", lw=0.8, ls=":")
-    ax1.set_ylabel("peak amplitude (1st harmonic)")
-    ax2.set_ylabel("frequency of the peak (Hz)")
-    ax2.set_xlabel(xlabel + ("   (dotted red: failed)" if failed else ""))
-    if log:
-        ax1.set_xscale("log")
-    for ax in (ax1, ax2):
-        ax.grid(True, alpha=0.3)
-    ax1.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
 
 
 # ---------------------------------------------------------------------------- driver
@@ -464,8 +336,10 @@ def sweep(case, key: str, values, outdir=None, *, ratio_key: str | None = None,
         write_summary_csv(out / "summary.csv", rows, outputs)
         if options.plot:
             vals = [t.value for t in tasks]
-            log = all(v > 0 for v in vals) and max(vals) >= 100 * min(vals)
+            log = all(v > 0 for v in vals) and (options.log_axis or max(vals) >= 100 * min(vals))
             label = (f"force ratio {ratio_key or find_ratio_key(tasks[0].raw)} / F" if key == FORCE_RATIO
                      else key)
-            write_plot(out / "sweep.png", rows, outputs, label, log)
+            base = case_from_dict(tasks[0].raw, tasks[0].path, Path(tasks[0].base_dir)).excitation.base
+            write_plot(out / "sweep.png", rows, outputs, label, log,
+                       {t.index: out / "runs" / t.name for t in tasks}, "m/m" if base is not None else "m/N")
     return SweepResult(key, rows, out)

@@ -97,8 +97,8 @@ def test_friction_optimum_strictly_inside(slip_sweep):
 def test_summary_csv_matches_the_runs(slip_sweep):
     res, out = slip_sweep
     rows = read_csv(out / "summary.csv")
-    assert list(rows[0]) == ["index", "value", "status", "reused", "x_peak", "x_peak_freq_hz", "x_peak_max",
-                             "n_points", "solve_seconds", "message"]
+    assert list(rows[0]) == ["index", "value", "status", "reused", "force", "x_peak", "x_peak_freq_hz",
+                             "x_peak_max", "x_receptance", "n_points", "solve_seconds", "message"]
     assert [float(r["value"]) for r in rows] == SLIPS
     assert all(r["status"] == "finished" and r["reused"] == "0" for r in rows)
     runs = sorted((out / "runs").iterdir())
@@ -109,6 +109,7 @@ def test_summary_csv_matches_the_runs(slip_sweep):
         assert float(r["x_peak"]) == pytest.approx(frf[j, 1], rel=1e-9)
         assert float(r["x_peak_freq_hz"]) == pytest.approx(frf[j, 0], rel=1e-9)
         assert float(r["x_peak_max"]) == pytest.approx(frf[:, 2].max(), rel=1e-9)
+        assert float(r["force"]) == 5.0 and float(r["x_receptance"]) == pytest.approx(frf[j, 1] / 5.0, rel=1e-9)
         assert int(r["n_points"]) == len(frf)
         s = json.loads((d / "summary.json").read_text())
         assert s["sweep"]["value"] == float(r["value"]) and s["settings"]["harmonics"] == [1, 2, 3]
@@ -165,20 +166,27 @@ def test_kill_midway_then_resume(tmp_path):
 
 def test_force_ratio_through_cli_with_a_process_pool(tmp_path, capsys):
     out = tmp_path / "fr"
-    code = main(["sweep", str(RIG), "--force-ratio", "0.4,4", "--ratio-key", "element.0.slip_force",
+    code = main(["sweep", str(RIG), "--force-ratio", "0.4,4,400", "--ratio-key", "element.0.slip_force",
                  "-o", str(out), "--harmonics", "3", "--jobs", "2", "-q"])
     assert code == 0, capsys.readouterr().err
     rows = read_csv(out / "summary.csv")
-    assert [float(r["value"]) for r in rows] == [0.4, 4.0]
-    for d, R in zip(sorted((out / "runs").iterdir()), (0.4, 4.0)):
+    assert [float(r["value"]) for r in rows] == [0.4, 4.0, 400.0]
+    for d, R in zip(sorted((out / "runs").iterdir()), (0.4, 4.0, 400.0)):
         s = json.loads((d / "summary.json").read_text())
         assert s["sweep"]["changed"]["excitation.amplitude"] == pytest.approx([2.0 / R])
         assert s["sweep"]["changed"]["element.0.slip_force"] == 2.0
     # the Jenkins law is positively homogeneous: the peak over F is set by the ratio alone,
     # so a ratio of 4 (mostly stuck) gives a smaller normalised peak than 0.4 (mostly slipping)
-    p = [float(r["x_peak"]) * R / 2.0 for r, R in zip(rows, (0.4, 4.0))]
-    assert p[1] < p[0]
-    assert "optimum for x" in capsys.readouterr().out
+    p = [float(r["x_peak"]) * R / 2.0 for r, R in zip(rows, (0.4, 4.0, 400.0))]
+    assert p[1] < p[0] and p[1] < p[2]
+    for r, R in zip(rows, (0.4, 4.0, 400.0)):
+        assert float(r["force"]) == pytest.approx(2.0 / R)
+        assert float(r["x_receptance"]) == pytest.approx(float(r["x_peak"]) * R / 2.0, rel=1e-9)
+    # the optimum is the smallest receptance (R = 4), not the smallest amplitude (R = 400,
+    # the smallest force: nearly stuck, its amplitude is the least but its receptance is not)
+    assert float(min(rows, key=lambda r: float(r["x_peak"]))["value"]) == 400.0
+    text = capsys.readouterr().out
+    assert "optimum for x (smallest peak receptance = peak / force): force_ratio = 4 " in text
 
 
 def test_force_ratio_needs_a_force_key(tmp_path, capsys):
