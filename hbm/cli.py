@@ -160,7 +160,8 @@ def cmd_frf(args) -> int:
     for name, jumps in (summary["jumps"] or {}).items():
         for way in ("up", "down"):
             for j in jumps[way]:
-                after = "no stable branch" if j["amplitude_after"] is None else f"{j['amplitude_after']:.6g}"
+                after = ("no stable branch (no stable point to land on in the traced path: "
+                         "check with hbm timesim)" if j["amplitude_after"] is None else f"{j['amplitude_after']:.6g}")
                 print(f"  jump {name} (sweep {way}) at {j['from_hz']:.6g} Hz: "
                       f"{j['amplitude_before']:.6g} -> {after}")
     for key in ("stability_warning", "closure_warning"):

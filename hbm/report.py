@@ -18,19 +18,33 @@ import numpy as np
 from .jumps import predict_jumps
 
 
-def peaks(freq: np.ndarray, amp: np.ndarray) -> list:
-    """Local maxima of ``amp`` along the path: ``[{"freq_hz": f, "amplitude": a}, ...]``."""
-    out = []
-    n = amp.size
-    for i in range(n):
-        left = amp[i - 1] if i > 0 else -np.inf
-        right = amp[i + 1] if i < n - 1 else -np.inf
-        if amp[i] > left and amp[i] >= right and 0 < i < n - 1:
-            out.append({"freq_hz": float(freq[i]), "amplitude": float(amp[i])})
-    if not out and n:
-        i = int(np.argmax(amp))
-        out.append({"freq_hz": float(freq[i]), "amplitude": float(amp[i])})
-    return out
+PEAK_PROMINENCE = 0.1
+
+
+def peaks(freq: np.ndarray, amp: np.ndarray, prominence: float = PEAK_PROMINENCE) -> list:
+    """Resonance peaks of ``amp`` along the path: ``[{"freq_hz": f, "amplitude": a}, ...]``.
+
+    A peak is a local maximum whose prominence (:func:`scipy.signal.find_peaks`: its height
+    above the higher of the two lowest points that separate it from higher ground) is at
+    least ``prominence`` times its own height, so that ripples of a stick-slip transition or
+    a fold are not reported as resonances.  When none qualifies (a window that holds only a
+    flank), the largest amplitude is reported.
+
+    Parameters
+    ----------
+    freq, amp : ndarray, shape (n,)
+        Frequencies (Hz) and amplitudes along the path.
+    prominence : float
+        Least prominence relative to the peak's height.
+    """
+    from scipy.signal import find_peaks
+    amp = np.asarray(amp, dtype=float)
+    if not amp.size:
+        return []
+    idx, _ = find_peaks(amp, prominence=(prominence * np.abs(amp), None))
+    if not idx.size:
+        idx = np.array([int(np.argmax(amp))])
+    return [{"freq_hz": float(freq[i]), "amplitude": float(amp[i])} for i in idx]
 
 
 def format_csv(res) -> str:
