@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .condensed_kernels import condensed_linear, modal_receptances, proportional_linear
+from .condensed_kernels import condensed_linear, proportional_linear
 from .reduction import receptance_stack
 
 WOODBURY_MIN_CONTACTS = 12     # below this the compiled per-harmonic inverse is faster

@@ -4,7 +4,7 @@
 column ``NAME`` per element output (a per-period scalar such as ``contact.slip_fraction``), then
 ``stable`` (1/0, empty when not computed); rows follow the continuation path.  ``summary.json``
 adds ``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.jumps`) when
-the stability was computed.  ``frf.png`` draws unstable parts of the path dashed.
+the stability was computed.  ``frf.png``: :mod:`hbm.frf_plot`.
 """
 from __future__ import annotations
 
@@ -15,7 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .frf_plot import write_plot
 from .jumps import predict_jumps
+from .sweep_summary import excitation_scale
 
 
 PEAK_PROMINENCE = 0.1
@@ -114,48 +116,6 @@ def summary_dict(case, res, extra=None) -> dict:
     return d
 
 
-def _runs(stable: np.ndarray) -> list:
-    """Index ranges ``(a, b, is_stable)`` of equal stability, each sharing its first point
-    with the previous range so that the drawn curve has no gaps."""
-    out, a = [], 0
-    for i in range(1, stable.size + 1):
-        if i == stable.size or stable[i] != stable[a]:
-            out.append((max(a - 1, 0), i - 1, bool(stable[a])))
-            a = i
-    return out
-
-
-def write_plot(res, path: Path, title: str) -> None:
-    """FRF plot: first harmonic (thick) and max |x| (thin) per output; unstable parts dashed."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    stable = np.ones(res.freq_hz.size, dtype=bool) if res.stable is None else np.asarray(res.stable)
-    runs = _runs(stable)
-    for name, o in res.outputs.items():
-        color = None
-        for curve, lw, label in ((o.h1, 1.5, f"{name} (1st harmonic)"), (o.max, 0.8, f"{name} (max |x|)")):
-            first = True
-            for a, b, ok in runs:
-                line, = ax.plot(res.freq_hz[a:b + 1], curve[a:b + 1], "-" if ok else "--", lw=lw,
-                                color=color, label=label if first else None)
-                color = line.get_color()
-                first = False
-    if res.stable is not None and not stable.all():
-        ax.plot([], [], "k--", lw=1.0, label="unstable (Hill)")
-    for f in res.folds_hz:
-        ax.axvline(f, color="0.6", lw=0.6, ls=":")
-    ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel("amplitude")
-    ax.set_title(title)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
 def write_frf(case, res, outdir, extra=None) -> dict:
     """Write the three files into ``outdir`` (created); returns the summary dict."""
     out = Path(outdir)
@@ -165,5 +125,6 @@ def write_frf(case, res, outdir, extra=None) -> dict:
     with open(out / "summary.json", "w") as fh:
         json.dump(summary, fh, indent=2)
     if res.freq_hz.size:
-        write_plot(res, out / "frf.png", case.name)
+        unit = "m/m" if case.excitation.base is not None and not np.any(case.excitation.force) else "m/N"
+        write_plot(res, out / "frf.png", case.name, excitation_scale(case), unit, summary["jumps"])
     return summary
