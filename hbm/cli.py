@@ -108,12 +108,6 @@ def build_parser():
     return p
 
 
-def _progress(n, f):
-    if n % 25 == 0:
-        sys.stderr.write(f"\r  {n} points, at {f:.5g} Hz")
-        sys.stderr.flush()
-
-
 def _check_outdir(path):
     """Create the output folder and write a probe file in it before any solving, so that a
     folder that cannot hold the results is refused in one line instead of after the run."""
@@ -136,13 +130,19 @@ def _defaults_note(st) -> str:
 def cmd_frf(args) -> int:
     from .response import frf
     from .report import write_frf
+    from .progress import FRFProgress, compile_notice
     case = load_case(args.case)
     _check_outdir(args.out)
-    res = frf(case, harmonics=args.harmonics, samples=args.samples, fmin=args.fmin, fmax=args.fmax,
-              transform=args.transform, progress=None if args.quiet else _progress,
-              stability=args.stability)
+    bar = None
     if not args.quiet:
-        sys.stderr.write("\r" + " " * 40 + "\r")
+        compile_notice()
+        bar = FRFProgress(args.fmin or case.analysis.freq_hz[0], args.fmax or case.analysis.freq_hz[1])
+    try:
+        res = frf(case, harmonics=args.harmonics, samples=args.samples, fmin=args.fmin, fmax=args.fmax,
+                  transform=args.transform, progress=bar, stability=args.stability)
+    finally:
+        if bar is not None:
+            bar.close()
     summary = write_frf(case, res, args.out)
     print(f"{case.name}: {summary['n_points']} points, {summary['newton_iterations']} Newton iterations, "
           f"{summary['solve_seconds']:.3f} s, H={res.settings['harmonics'][-1]}, N={res.settings['time_samples']}"
@@ -179,7 +179,6 @@ def cmd_frf(args) -> int:
 def cmd_timesim(args) -> int:
     import dataclasses
     import math
-    import time
     from .timesim import TimeSimOptions, timesim
     from .timesim_report import write_timesim
     f = args.freq_hz
@@ -194,28 +193,26 @@ def cmd_timesim(args) -> int:
                                ("alpha", args.alpha)) if v is not None}
     opts = dataclasses.replace(TimeSimOptions(), **over)
     opts.validate()
+    from .progress import CountProgress, compile_notice
     case = load_case(args.case)
     _check_outdir(args.out)
-    t_start = time.perf_counter()
-    shown = [False]
+    bar = None
+    if not args.quiet:
+        compile_notice()
+        bar = CountProgress(args.periods or opts.max_periods, "periods", "timesim")
 
     def progress(periods, change):
-        if args.quiet or time.perf_counter() - t_start < 1.0:
-            return
-        ch = f", change {change:.1e}" if change >= 0 else ""
-        sys.stderr.write(f"\r  timesim: {periods} periods{ch}   ")
-        sys.stderr.flush()
-        shown[0] = True
+        if bar is not None:
+            bar(periods, f"change {change:.1e}" if change >= 0 else "")
 
     try:
         res = timesim(case, f, opts, periods=args.periods, switch_off_at=args.switch_off_at, progress=progress)
     except RuntimeError as exc:
-        if shown[0]:
-            sys.stderr.write("\n")
         sys.stderr.write(f"hbm: timesim failed: {exc}\n")
         return 1
-    if shown[0]:
-        sys.stderr.write("\r" + " " * 50 + "\r")
+    finally:
+        if bar is not None:
+            bar.close()
     write_timesim(case, res, args.out)
     n = opts.steps
     if res.mode == "steady":
@@ -238,11 +235,6 @@ def cmd_timesim(args) -> int:
     return 0
 
 
-def _sweep_progress(done, total, failed):
-    sys.stderr.write(f"\r  sweep: {done}/{total} done" + (f", {failed} failed" if failed else "") + " ")
-    sys.stderr.flush()
-
-
 def cmd_sweep(args) -> int:
     from .sweep import FORCE_RATIO, FRFOverrides, SweepOptions, parse_assignment, parse_values, sweep
     if args.force_ratio is not None:
@@ -257,10 +249,17 @@ def cmd_sweep(args) -> int:
     from .response import resolve_settings
     resolve_settings(case, args.harmonics, args.samples, args.fmin, args.fmax, args.transform)
     opts = SweepOptions(jobs=args.jobs, dask=args.dask, resume=args.resume, log_axis=args.log)
-    res = sweep(case, key, values, args.out, ratio_key=args.ratio_key, overrides=overrides, options=opts,
-                progress=None if args.quiet else _sweep_progress)
+    from .progress import CountProgress, compile_notice
+    bar = None
     if not args.quiet:
-        sys.stderr.write("\n")
+        compile_notice()
+        bar = CountProgress(len(values), "FRFs", "sweep")
+    try:
+        res = sweep(case, key, values, args.out, ratio_key=args.ratio_key, overrides=overrides, options=opts,
+                    progress=None if bar is None else lambda d, t, nf: bar(d, f"{nf} failed" if nf else ""))
+    finally:
+        if bar is not None:
+            bar.close()
     outputs = list(case.analysis.outputs)
     print(f"{case.name}: sweep of {key} over {len(res.rows)} values, {res.n_failed} failed")
     for r in res.rows:

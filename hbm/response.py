@@ -397,7 +397,8 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     transform : str, optional
         ``auto``, ``dft``, ``numpy`` or ``fftw``.
     progress : callable, optional
-        Called as ``progress(n_points, freq_hz)`` after every converged point.
+        Called as ``progress(n_points, freq_hz)`` after every converged point, and as
+        ``progress(n_points, None)`` when the stability pass starts.
     options : ArclengthOptions, optional
     stability : bool
         Decide the stability of every point by Hill's method (``FRFResult.stable``);
@@ -465,6 +466,8 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     _closure_warning(settings, pts.unclosed, pts.w)
     stable = None
     if stability:
+        if progress is not None:
+            progress(len(pts_w), None)
         stable, margin = _path_verdicts(problem, pts_X, np.array(pts_w), segments, stability_options)
         settings["stability_spectra"] = int(np.isfinite(margin).sum())
         growth = margin / np.array(pts_w)

@@ -27,6 +27,29 @@ def test_frf_writes_csv_png_summary(tmp_path):
     s = json.loads((out / "summary.json").read_text())
     assert s["n_points"] == len(rows) - 1 and s["peaks"]["x"] and s["status"] == "finished"
     assert (out / "frf.png").stat().st_size > 1000
+    # stderr is a pipe here, not a terminal: no progress bar, no carriage returns in a log
+    assert "\r" not in r.stderr and "FRF" not in r.stderr
+
+
+def test_progress_follows_the_window_not_the_path():
+    from hbm.progress import FRFProgress
+    bar = FRFProgress(20.0, 50.0)
+    for n, f in enumerate((20.0, 35.0, 32.0, 41.0, 50.0)):     # a fold turns back at 35 Hz
+        bar(n, f)
+        assert bar.done == pytest.approx(max(0.0, (max((20.0, 35.0, 32.0, 41.0, 50.0)[:n + 1]) - 20) / 30 * 100))
+    bar(5, None)                                               # the stability pass
+    bar.close()
+
+
+def test_version_and_rigs(capsys):
+    from hbm.cli import main
+    import hbm
+    with pytest.raises(SystemExit) as e:
+        main(["--version"])
+    assert e.value.code == 0 and capsys.readouterr().out.strip() == f"hbm-friction {hbm.__version__}"
+    assert main(["rigs"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert any(line.startswith(str(ROOT / "rigs" / "upd_rig.toml")) for line in lines) and len(lines) >= 8
 
 
 def write(tmp_path, text):
