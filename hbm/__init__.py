@@ -4,8 +4,10 @@
 >>> case = hbm.load_case("rigs/sdof_jenkins.toml")
 >>> res = hbm.frf(case, harmonics=7)
 >>> res.freq_hz, res.outputs["x"].h1
+>>> res.table()                     # the frf.csv columns as arrays (res.to_frame() with pandas)
+>>> loops = hbm.contact_loops(case, res, res.nearest(32.0))   # forces over one period
 """
-from .case import Case, CaseError, load_case
+from .case import Case, CaseError, case_from_dict, load_case
 
 __version__ = "0.2.0"
 
@@ -22,4 +24,10 @@ def timesim(case, freq_hz, options=None, **kwargs):
     return _timesim(case, freq_hz, options, **kwargs)
 
 
-__all__ = ["__version__", "Case", "CaseError", "load_case", "frf", "timesim"]
+def contact_loops(case, result, point):
+    """Element forces and hysteresis loops at one FRF point; see :func:`hbm.element_loops.contact_loops`."""
+    from .element_loops import contact_loops as _loops
+    return _loops(case, result, point)
+
+
+__all__ = ["__version__", "contact_loops", "case_from_dict", "Case", "CaseError", "load_case", "frf", "timesim"]

@@ -93,6 +93,38 @@ class FRFResult:
     def ok(self) -> bool:
         return self.status == "finished"
 
+    def __repr__(self) -> str:
+        f = self.freq_hz
+        span = f"{f.min():.6g}..{f.max():.6g} Hz" if f.size else "no points"
+        h = self.settings.get("harmonics", [])
+        return (f"FRFResult({self.status}, {f.size} points, {span}, H={h[-1] if h else '?'}, "
+                f"outputs={list(self.outputs)}, stable={'computed' if self.stable is not None else 'not computed'})")
+
+    def nearest(self, freq_hz: float) -> int:
+        """Index of the point nearest to ``freq_hz`` along the path (the first, at a fold)."""
+        return int(np.argmin(np.abs(self.freq_hz - float(freq_hz))))
+
+    def table(self) -> dict:
+        """The ``frf.csv`` columns as arrays (name -> ndarray (n_points,)), in file order, plus
+        ``energy_error``; ``stable`` is float (1/0, NaN when not computed)."""
+        cols = {"freq_hz": self.freq_hz}
+        for name, o in self.outputs.items():
+            cols[f"{name}_h1"], cols[f"{name}_max"] = o.h1, o.max
+        cols.update(self.element_outputs)
+        cols["stable"] = (np.full(self.freq_hz.size, np.nan) if self.stable is None
+                          else np.asarray(self.stable, dtype=float))
+        cols["energy_error"] = self.energy_error
+        return cols
+
+    def to_frame(self):
+        """:meth:`table` as a pandas DataFrame (needs pandas: ``pip install 'hbm-friction[pandas]'``)."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("FRFResult.to_frame needs pandas (pip install 'hbm-friction[pandas]'); "
+                              "FRFResult.table() gives the same columns as arrays") from None
+        return pd.DataFrame(self.table())
+
 
 def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None):
     """Analysis settings with command-line / API overrides applied and validated.
