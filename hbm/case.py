@@ -1,6 +1,6 @@
 """Case files (TOML): read, validate, and turn into an immutable :class:`Case`.
 
-Schema (``../shared/DESIGN.md``)::
+Schema (every key and its meaning: :mod:`hbm.schema`, ``docs/case-reference.md``)::
 
     name = "..."
     [model]       one source:  mass, stiffness [, dof_names]        (inline matrices)
@@ -51,6 +51,7 @@ from elements.base import coordinate_row
 from .fourier import parse_harmonics, min_samples, default_samples
 from .linear import LinearModel
 from .model_io import load_model_file
+from .schema import table_keys
 from .structure import Damping, ReductionSettings, Structure
 
 EAGER_CHECK_DOF = 60       # dense models up to this size are fully validated at load time
@@ -60,23 +61,32 @@ class CaseError(ValueError):
     """Bad input in a case file or on the command line (one-line message)."""
 
 
-TOP_KEYS = ("name", "model", "element", "excitation", "analysis")
-MODEL_KEYS = ("mass", "stiffness", "damping", "rayleigh", "modal_damping", "dof_names", "file",
-              "builder", "beam", "body", "spring", "solver", "modes", "residual_flexibility")
+TOP_KEYS = table_keys("top level")
+MODEL_KEYS = table_keys("[model]")
 BUILDER_TABLES = ("beam", "body", "spring")
 BUILDERS = ("beam",)
-EXCITATION_KEYS = ("dofs", "amplitude", "base")
-BASE_KEYS = ("dofs", "amplitude")
-ANALYSIS_KEYS = ("harmonics", "time_samples", "frequency_hz", "outputs", "max_points", "transform")
+EXCITATION_KEYS = table_keys("[excitation]")
+BASE_KEYS = table_keys("[excitation] base")
+ANALYSIS_KEYS = table_keys("[analysis]")
 
 
 @dataclass(frozen=True)
 class Excitation:
-    """Cosine force at the first harmonic, ``force`` (n,) in N, and optionally imposed
-    support motion ``base = (dofs (k,), amplitude (k,))`` in m (cosine, first harmonic)."""
+    """Force at the first harmonic, ``force (n,) cos(w t) + force_sine (n,) sin(w t)`` in N
+    (a phase per DOF, ``F_i cos(w t - p_i)``, gives ``F_i cos p_i`` and ``F_i sin p_i``), and
+    optionally imposed support motion ``base = (dofs (k,), amplitude (k,))`` in m (cosine)."""
 
     force: np.ndarray
     base: tuple | None = None
+    force_sine: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.force_sine is None:
+            object.__setattr__(self, "force_sine", np.zeros_like(self.force))
+
+    @property
+    def has_sine(self) -> bool:
+        return bool(np.any(self.force_sine))
 
 
 @dataclass(frozen=True)
@@ -375,10 +385,14 @@ def _force_rows(t, model, coords, where, path):
 def _excitation(t, model, path):
     _check_keys(t, EXCITATION_KEYS, "[excitation]", path)
     coords = model.coordinates()
-    force = np.zeros(model.n_dof)
+    force, force_sine = np.zeros(model.n_dof), np.zeros(model.n_dof)
     if "dofs" in t or "amplitude" in t or "base" not in t:
         rows, amp = _force_rows(t, model, coords, "[excitation]", path)
-        force = amp @ rows            # a force along a coordinate g: f = a g
+        phase = np.radians(_phases(t, amp.size, path))
+        force = (amp * np.cos(phase)) @ rows       # a force along a coordinate g: f = a g
+        force_sine = (amp * np.sin(phase)) @ rows
+    elif "phase_deg" in t:
+        raise CaseError(f"{path}: [excitation] phase_deg needs dofs and amplitude (it phases the forces)")
     base = None
     if "base" in t:
         _check_keys(t["base"], BASE_KEYS, "[excitation] base", path)
@@ -390,12 +404,22 @@ def _excitation(t, model, path):
             raise CaseError(f"{path}: [excitation] base dofs repeats a DOF")
         if bd.size == model.n_dof:
             raise CaseError(f"{path}: [excitation] base: every DOF is a support: nothing is free")
-        if np.any(force[bd]):
+        if np.any(force[bd]) or np.any(force_sine[bd]):
             raise CaseError(f"{path}: [excitation] a DOF cannot be both forced and a moving support")
         base = (bd, ba)
-    if not np.any(force) and (base is None or not np.any(base[1])):
+    if not np.any(force) and not np.any(force_sine) and (base is None or not np.any(base[1])):
         raise CaseError(f"{path}: [excitation] amplitude is zero: nothing to respond to")
-    return Excitation(force, base)
+    return Excitation(force, base, force_sine)
+
+
+def _phases(t, k, path) -> np.ndarray:
+    """``[excitation] phase_deg`` (k,) in degrees, zeros when absent."""
+    if "phase_deg" not in t:
+        return np.zeros(k)
+    ph = t["phase_deg"]
+    if not isinstance(ph, list) or len(ph) != k:
+        raise CaseError(f"{path}: [excitation] phase_deg must be a list of {k} phases in degrees, one per DOF")
+    return np.array([_number(p, "[excitation] phase_deg", path) for p in ph])
 
 
 def _row(spec, model, coords, where, path) -> np.ndarray:

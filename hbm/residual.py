@@ -36,8 +36,9 @@ class HarmonicBalance:
     elements : sequence of Element
     basis : FourierBasis
         Must contain harmonic 1 (the excitation's).
-    force : ndarray, shape (n,)
-        Amplitude of the cosine excitation at the first harmonic, per DOF.
+    force : ndarray, shape (n,) or (2, n)
+        Excitation at the first harmonic per DOF: cosine amplitudes, or rows ``[cosine, sine]``
+        (``F_c cos(w t) + F_s sin(w t)``).
     transform : object
         AFT transform built on ``basis``.
     base : tuple (dofs, amplitude), optional
@@ -57,7 +58,10 @@ class HarmonicBalance:
         self.n_dof = n
         self.nl = NonlinearForces(basis, elements, n, transform)
         Fex = np.zeros((basis.n_coef, n))
-        Fex[basis.row_of(1, "c")] = np.asarray(force, dtype=float)
+        f = np.atleast_2d(np.asarray(force, dtype=float))
+        Fex[basis.row_of(1, "c")] = f[0]
+        if f.shape[0] > 1:
+            Fex[basis.row_of(1, "s")] = f[1]
         self.Fex = Fex
         fixed = np.zeros(n, dtype=bool)
         Xfix = np.zeros((basis.n_coef, n))

@@ -209,12 +209,16 @@ def build_problem(case: Case, basis: FourierBasis, transform: str):
     st = case.structure
     info = {"solver": solver, "n_dof": st.n_dof}
     if solver == "full":
-        problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force, tr,
+        ex = case.excitation
+        problem = HarmonicBalance(case.model, case.elements, basis, np.vstack([ex.force, ex.force_sine]), tr,
                                   base=case.excitation.base, output_rows=case.analysis.output_rows(st.n_dof))
         info.update(modes=None, reduction_seconds=0.0)
     elif case.excitation.base is not None:
         raise CaseError(f"{case.path}: [excitation] base (support motion) needs the full solver: "
                         f"set [model] solver = \"full\"")
+    elif case.excitation.has_sine:
+        raise CaseError(f"{case.path}: [excitation] phase_deg (forces out of phase) needs the full solver "
+                        f"for now: set [model] solver = \"full\"")
     else:
         G_o = case.analysis.output_rows(st.n_dof)
         force = case.excitation.force

@@ -33,7 +33,7 @@ OPTIMUM_QUANTITY = "receptance"
 def excitation_scale(case) -> float:
     """The excitation's scale ``F``: max |force amplitude| (N), or max |base amplitude| (m)."""
     ex = case.excitation
-    f = float(np.max(np.abs(ex.force))) if np.size(ex.force) else 0.0
+    f = float(np.max(np.hypot(ex.force, ex.force_sine))) if np.size(ex.force) else 0.0
     if f == 0.0 and ex.base is not None:
         f = float(np.max(np.abs(ex.base[1])))
     return f

@@ -4,7 +4,7 @@ Equations of motion (the same model, elements and excitation as the harmonic bal
 
 .. math::
 
-    M \ddot q + C \dot q + K q + \sum_e G_e^T f_e = F \cos(w t) \quad (t \le t_{off}),
+    M \ddot q + C \dot q + K q + \sum_e G_e^T f_e = F_c \cos(w t) + F_s \sin(w t) \quad (t \le t_{off}),
     \qquad F = 0 \ \text{after} \ t_{off}.
 
 Base (support) excitation (``[excitation] base``): the support DOFs ``b`` follow the prescribed
@@ -195,7 +195,7 @@ def _max_abs(x):
 
 
 @nb.njit(cache=True)
-def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
+def _step(M, C, K, F0, F1, h, alpha, newton_tol, max_iter,
           q0, v0, a0, f0, q1, v1, a1, f1,
           kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
           S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp,
@@ -234,7 +234,7 @@ def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
         old = f0[i]
         for j in range(n):
             old += C[i, j] * v0[j] + K[i, j] * q0[j]
-        tmp[i] = -alpha * old + alpha * load0 * F[i] - (1.0 + alpha) * load1 * F[i]
+        tmp[i] = -alpha * old + alpha * F0[i] - (1.0 + alpha) * F1[i]
     for it in range(max_iter + 1):
         for i in range(n):
             if fixed[i] != 0:
@@ -266,7 +266,7 @@ def _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
         # relative to the largest force term, including c0 |M| |q|: the inertia term is a
         # difference of displacements times c0 = 1/(beta h^2), so its round-off grows as h^-2
         # (the test then bounds the displacement error by about newton_tol |q|)
-        scale = big_i + big_r + abs(load1) * _max_abs(F) + c0 * mrow * _max_abs(q1) + 1e-300
+        scale = big_i + big_r + _max_abs(F1) + c0 * mrow * _max_abs(q1) + 1e-300
         if rnorm <= newton_tol * scale:
             return it
         if it == max_iter:
@@ -311,7 +311,7 @@ def _record(row, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v):
 
 
 @nb.njit(cache=True)
-def _march(M, C, K, F, w, t_off, N, k0, n_periods, check, tol, have_prev,
+def _march(M, C, K, F2, w, t_off, N, k0, n_periods, check, tol, have_prev,
            q, v, a, fnl, S, D, Dref,
            kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
            alpha, newton_tol, max_iter, max_level, jump_tol,
@@ -359,6 +359,8 @@ def _march(M, C, K, F, w, t_off, N, k0, n_periods, check, tol, have_prev,
     v1 = np.zeros(n)
     a1 = np.zeros(n)
     f1 = np.zeros(n)
+    F0 = np.zeros(n)
+    F1 = np.zeros(n)
     change = -1.0
     k = k0
     for pp in range(n_periods):
@@ -378,11 +380,15 @@ def _march(M, C, K, F, w, t_off, N, k0, n_periods, check, tol, have_prev,
                 t1 = (k * unit + pos + size) * (dt / unit)
                 th0 = 2.0 * np.pi * (kk * unit + pos) / (N * unit)
                 th1 = 2.0 * np.pi * (kk * unit + pos + size) / (N * unit)
-                load0 = np.cos(th0) if t0 <= t_off else 0.0
-                load1 = np.cos(th1) if t1 <= t_off else 0.0
+                on0 = 1.0 if t0 <= t_off else 0.0
+                on1 = 1.0 if t1 <= t_off else 0.0
+                cs0, sn0, cs1, sn1 = np.cos(th0), np.sin(th0), np.cos(th1), np.sin(th1)
+                for i in range(n):   # the load Fc cos + Fs sin at both ends of the step
+                    F0[i] = on0 * (cs0 * F2[0, i] + sn0 * F2[1, i])
+                    F1[i] = on1 * (cs1 * F2[0, i] + sn1 * F2[1, i])
                 for i in range(n):   # predictor: constant acceleration
                     q1[i] = q[i] + h * v[i] + 0.5 * h * h * a[i]
-                its = _step(M, C, K, F, h, load0, load1, alpha, newton_tol, max_iter,
+                its = _step(M, C, K, F0, F1, h, alpha, newton_tol, max_iter,
                             q, v, a, fnl, q1, v1, a1, f1,
                             kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
                             S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp,
@@ -754,7 +760,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     M = np.ascontiguousarray(case.model.M, dtype=float)
     C = np.ascontiguousarray(case.model.C, dtype=float)
     K = np.ascontiguousarray(case.model.K, dtype=float)
-    F = np.ascontiguousarray(case.excitation.force, dtype=float)
+    F2 = np.ascontiguousarray(np.vstack([case.excitation.force, case.excitation.force_sine]), dtype=float)
     rows = N + 1 if check else periods * N + 1
     rec_q = np.zeros((rows, n))
     rec_f = np.zeros((rows, n_f))
@@ -772,7 +778,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
         chunk = min(chunk, periods - done)
         tc = time.perf_counter()
         status, pp, ch, t_fail = _march(
-            M, C, K, F, w, t_off, N, done * N, chunk, check, opts.tol, done > 0,
+            M, C, K, F2, w, t_off, N, done * N, chunk, check, opts.tol, done > 0,
             state.q, state.v, state.a, state.fnl, state.S, state.D, state.Dref,
             *packed.args(), float(opts.alpha), float(opts.newton_tol), int(opts.max_iter),
             int(opts.max_level), float(opts.jump_tol),
