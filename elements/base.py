@@ -218,7 +218,8 @@ def require_keys(spec: dict, allowed, required, where: str) -> None:
     """Reject unknown keys by name, and name missing required ones."""
     unknown = [k for k in spec if k not in allowed]
     if unknown:
-        raise ValueError(f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(sorted(allowed))})")
+        raise ValueError(f"{where}: unknown key {unknown[0]!r}{did_you_mean(unknown[0], allowed)} "
+                         f"(allowed: {', '.join(sorted(allowed))})")
     for k in required:
         if k not in spec:
             raise ValueError(f"{where}: missing key {k!r}")
@@ -251,11 +252,18 @@ def non_negative(name, value) -> float:
     return v
 
 
+def did_you_mean(name: str, known) -> str:
+    """`` (did you mean 'x'?)`` for the closest of ``known`` names, or an empty string."""
+    import difflib
+    close = difflib.get_close_matches(name, [str(k) for k in known], n=2, cutoff=0.6)
+    return f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
+
+
 def dof_number(d, n_dof, dof_index, where) -> int:
     """A DOF given as an index or (with a name map) a name, checked against the model size."""
     if isinstance(d, str):
         if dof_index is None or d not in dof_index:
-            raise ValueError(f"{where}: unknown DOF name {d!r}")
+            raise ValueError(f"{where}: unknown DOF name {d!r}{did_you_mean(d, dof_index or ())}")
         v = dof_index[d]
         if isinstance(v, dict):
             raise ValueError(f"{where}: {d!r} is a combination of DOFs (a point coordinate), "

@@ -46,7 +46,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from elements import ELEMENTS
-from elements.base import coordinate_row
+from elements.base import coordinate_row, did_you_mean
 
 from .fourier import parse_harmonics, min_samples, default_samples
 from .linear import LinearModel
@@ -154,7 +154,8 @@ def _check_keys(table, allowed, where, path):
         raise CaseError(f"{path}: {where} must be a table")
     for k in table:
         if k not in allowed:
-            raise CaseError(f"{path}: unknown key {k!r} in {where} (allowed: {', '.join(allowed)})")
+            raise CaseError(f"{path}: unknown key {k!r} in {where}{did_you_mean(k, allowed)} "
+                            f"(allowed: {', '.join(allowed)})")
 
 
 def _matrix(value, name, path):

@@ -462,4 +462,4 @@ class CondensedHarmonicBalance:
             eta = np.linalg.solve(D, g[:, :, None])[:, :, 0]
         v = iW * eta
         w_v = float(np.vdot(v, v @ Cm.T).real)
-        return EnergyBalance(w_ex, np.pi / w * w_v, w_nl)
+        return EnergyBalance(w_ex, np.pi / w * w_v, w_nl, np.pi * float(abs(ye)))   # |F_e| = 1

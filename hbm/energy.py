@@ -11,6 +11,13 @@ At a converged point the excitation's work equals the viscous plus the friction 
 :math:`W[F_{ex}] = \frac{T}{2}\sum_r V_r^T C V_r + W[F_{nl}]` (stiffness and mass forces do
 no work over a period).  Supports with imposed motion (base excitation) add the work of
 the force that drives them, ``W[R_b]`` on their velocities, to the input.
+
+The relative error is the imbalance over the largest of the three works and of a round-off
+floor ``ROUNDOFF_SHARE * S``, with ``S = (T/2) |F_ex| |V|`` the most work the excitation
+could do at this motion (Cauchy-Schwarz).  Without the floor a point that dissipates nothing
+(an undamped structure with its contacts stuck: every work is zero up to round-off) had a
+"relative error" of 1 and was refused; with it, such a point passes when its imbalance is
+at round-off level against ``S``, and a dissipating point is judged as before.
 A problem that carries its own balance (the condensed problem of
 :mod:`hbm.condensed`, whose viscous work comes from modal coordinates) provides
 ``problem.energy_balance(X, w)``, which :func:`energy_balance` uses.
@@ -22,17 +29,25 @@ from dataclasses import dataclass
 import numpy as np
 
 
+ROUNDOFF_SHARE = 1e-6     # floor of the reference work, as a share of the bound S
+
+
 @dataclass(frozen=True)
 class EnergyBalance:
-    """Work per period (J): excitation input, viscous and nonlinear dissipation, relative error."""
+    """Work per period (J): excitation input, viscous and nonlinear dissipation, relative error.
+
+    ``bound`` is ``S``, the largest work the excitation could do at this motion (module doc).
+    """
 
     excitation: float
     viscous: float
     nonlinear: float
+    bound: float = 0.0
 
     @property
     def relative_error(self) -> float:
-        ref = max(abs(self.excitation), abs(self.viscous) + abs(self.nonlinear), 1e-300)
+        ref = max(abs(self.excitation), abs(self.viscous) + abs(self.nonlinear),
+                  ROUNDOFF_SHARE * self.bound, 1e-300)
         return abs(self.excitation - self.viscous - self.nonlinear) / ref
 
 
@@ -55,6 +70,9 @@ def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
     def on_v(F):                            # work() on the velocities of every DOF
         return float(np.pi / w * np.vdot(F[s:], Vp))
     w_ex = on_v(problem.Fex)
+    bound = np.pi / w * float(np.linalg.norm(problem.Fex[s:]) * np.linalg.norm(Vp))
     if problem.fixed.size:
-        w_ex += work(basis, problem.support_reactions(X, w), V[:, problem.fixed], w)
-    return EnergyBalance(w_ex, on_v(V @ problem.model.C), on_v(problem.nonlinear_forces(X, w)))
+        Rb = problem.support_reactions(X, w)
+        w_ex += work(basis, Rb, V[:, problem.fixed], w)
+        bound += np.pi / w * float(np.linalg.norm(Rb[s:]) * np.linalg.norm(V[s:, problem.fixed]))
+    return EnergyBalance(w_ex, on_v(V @ problem.model.C), on_v(problem.nonlinear_forces(X, w)), bound)

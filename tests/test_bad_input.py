@@ -291,3 +291,16 @@ def test_bad_input_in_a_subprocess(tmp_path, make, args, needle):
     r = subprocess.run([sys.executable, "-m", "hbm", *argv, "-o", str(tmp_path / "o")],
                        capture_output=True, text=True)
     check(r.returncode, r.stderr, needle)
+
+
+def test_misspelled_names_get_a_suggestion():
+    from hbm.case import CaseError, case_from_dict
+    raw = {"model": {"mass": [1.0, 1.0], "stiffness": [1.0, 1.0], "damping": [0.1, 0.1],
+                     "dof_names": ["blade.x", "blade.y"]},
+           "excitation": {"dofs": ["blade.xx"], "amplitude": [1.0]},
+           "analysis": {"harmonics": 1, "frequency_hz": [0.1, 0.2], "outputs": {"x": "blade.x"}}}
+    with pytest.raises(CaseError, match=r"unknown DOF name 'blade.xx' \(did you mean 'blade.x'"):
+        case_from_dict(raw)
+    raw["excitation"] = {"dofs": ["blade.x"], "amplitudes": [1.0]}
+    with pytest.raises(CaseError, match=r"unknown key 'amplitudes' in \[excitation\] \(did you mean 'amplitude'\?\)"):
+        case_from_dict(raw)

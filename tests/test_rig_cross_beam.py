@@ -92,3 +92,19 @@ def test_energy_density_optimum_in_stick_slip():
     # the optimum moves with f: the problem is homogeneous, e(f, N) = e(20, 20 N / f)
     case = st.case_at(loads[k] / 2, force=10.0)
     assert st.energy_density(case, st.from_rest(case)) == pytest.approx(e[k], rel=1e-6)
+
+
+def test_frf_below_breakaway_passes_the_energy_check():
+    """C = 0 and both dampers stuck below breakaway: no work is done at all, every work of the
+    balance is zero up to round-off.  The energy error is judged against the most work the
+    excitation could do at that motion (hbm.energy); against the zero works it read 1.0 and
+    the FRF stopped at its first point."""
+    import hbm
+    from hbm.energy import energy_balance
+    from hbm.response import build_problem
+    case = hbm.load_case(ROOT / "rigs" / "cross_beam.toml")
+    res = hbm.frf(case, fmax=34.0, stability=False)
+    assert res.ok and res.freq_hz.size >= 5 and res.energy_error.max() < 1e-10, res.message
+    problem, _ = build_problem(case, res.basis, res.settings["transform"])
+    eb = energy_balance(problem, res.X[0], 2 * np.pi * res.freq_hz[0])
+    assert abs(eb.excitation) < 1e-12 * eb.bound and abs(eb.nonlinear) < 1e-12 * eb.bound
