@@ -152,10 +152,10 @@ class CondensedHarmonicBalance:
         if 1 not in basis.harmonics:
             raise ValueError("the harmonic list must contain harmonic 1 (the excitation's)")
         n = reduced.n_dof
-        force = np.asarray(force, dtype=float)
-        if force.shape != (n,) or not np.any(force):
-            raise ValueError(f"force must be a non-zero vector of {n} amplitudes")
-        G_e = force[None, :]
+        force = np.atleast_2d(np.asarray(force, dtype=float))
+        if force.shape not in ((1, n), (2, n)) or not np.any(force):
+            raise ValueError(f"force must be a non-zero vector of {n} amplitudes (or cosine and sine rows)")
+        G_e = force[:1] if force.shape[0] == 1 or not np.any(force[1]) else force
         if elements:
             G_c, A = contact_coordinates(elements, n)
             elems = [_regathered(e, a) for e, a in zip(elements, A)]
@@ -171,8 +171,10 @@ class CondensedHarmonicBalance:
         self.n_dof = nc
         self.nl = NonlinearForces(basis, elems, nc, transform)
         nco = basis.n_coef
-        F_e = np.zeros((nco, 1))
+        F_e = np.zeros((nco, G_e.shape[0]))      # unit cosine on the first row, unit sine on the second
         F_e[basis.row_of(1, "c"), 0] = 1.0
+        if G_e.shape[0] == 2:
+            F_e[basis.row_of(1, "s"), 1] = 1.0
         self.F_e = F_e
         # all kept coordinates stacked: contact, excitation, output
         G_all = np.vstack([cm.G_c, cm.G_e, cm.G_o])
@@ -199,9 +201,9 @@ class CondensedHarmonicBalance:
         to_r[self._rc, np.arange(h.size)] = 1.0
         to_r[self._rs, self._pos] = 1j
         self._to_c, self._to_r = to_c, to_r
-        self._builder = LinearBuilder(reduced, self._phi_all, self._R_all, nc, ne, self._h, self._rc, self._i1,
-                                      linear_strategy)
         self._Fe_c = self._complex(F_e)
+        self._builder = LinearBuilder(reduced, self._phi_all, self._R_all, nc, ne, self._h, self._rc, self._i1,
+                                      linear_strategy, self._Fe_c[self._i1])
         self._ge = self._Fe_c @ self._phi["e"]          # Phi^T G_e^T F_e per harmonic, (n_h, m)
         d = self.nl.dofs
         self._nl_all = d.size == nc
@@ -402,8 +404,9 @@ class CondensedHarmonicBalance:
         nc = self.n_dof
         free, stuck = np.zeros(nc), np.zeros(nc)
         for w in ws:               # one frequency at a time: n_c^2 memory, not n_w n_c^2
-            H = self._builder.receptances(np.array([w]), np.arange(nc), np.arange(nc + 1))[0]
-            u = H[:, nc]                                       # (n_c,) contact response to F_e
+            ne = self._Fe_c.shape[1]
+            H = self._builder.receptances(np.array([w]), np.arange(nc), np.arange(nc + ne))[0]
+            u = H[:, nc:] @ self._Fe_c[self._i1]               # (n_c,) contact response to F_e
             free = np.maximum(free, np.abs(u))
             try:
                 stuck = np.maximum(stuck, np.abs(np.linalg.solve(np.eye(nc) + H[:, :nc] @ Ks, u)))
@@ -439,15 +442,17 @@ class CondensedHarmonicBalance:
         In complex form per harmonic (``X_h = Xc - i Xs``, velocity ``i h w X_h``), the work of
         ``F`` on the motion ``Y`` over a period is ``-pi sum_h h Im(conj(F_h) Y_h)``; for the unit
         cosine excitation at harmonic 1 that is ``-pi Im(y_e)`` with ``y_e`` the excitation
-        coordinate's harmonic-1 amplitude.
+        coordinate's harmonic-1 amplitude (with a sine row, ``-pi Im(conj(F_e) . y_e)``).
         """
         r = self.reduced
         L = self._linear(w)
         fp = self._implied_forces(X, L)
         w_nl = np.pi * float(np.vdot(self.nonlinear_forces(X, w), self.basis.D @ X))
         i1, nc = self._i1, self.n_dof
-        ye = L.Hx[i1, 0, nc] - L.Hx[i1, 0, :nc] @ fp[i1]             # y_e = H_ee F_e - H_ec F'
-        w_ex = -np.pi * float(ye.imag)
+        ne = self._Fe_c.shape[1]
+        fe = self._Fe_c[i1]
+        ye = L.Hx[i1, :ne, nc:] @ fe - L.Hx[i1, :ne, :nc] @ fp[i1]   # y_e = H_ee F_e - H_ec F'
+        w_ex = -np.pi * float(np.vdot(fe, ye).imag)
         # modal amplitudes under F_e and -F' (the mean, W = 0, does no work)
         W = self._h * w
         iW = (1j * W)[:, None]
@@ -462,4 +467,4 @@ class CondensedHarmonicBalance:
             eta = np.linalg.solve(D, g[:, :, None])[:, :, 0]
         v = iW * eta
         w_v = float(np.vdot(v, v @ Cm.T).real)
-        return EnergyBalance(w_ex, np.pi / w * w_v, w_nl, np.pi * float(abs(ye)))   # |F_e| = 1
+        return EnergyBalance(w_ex, np.pi / w * w_v, w_nl, np.pi * float(np.linalg.norm(fe) * np.linalg.norm(ye)))

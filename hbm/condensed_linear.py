@@ -82,11 +82,14 @@ class LinearBuilder:
         positive definite, else dense) or one of ``compiled``, ``woodbury``, ``dense``.
     """
 
-    def __init__(self, reduced, phi_all, R_all, n_c, n_e, hs, rows, i1, strategy="auto"):
+    def __init__(self, reduced, phi_all, R_all, n_c, n_e, hs, rows, i1, strategy="auto", fe=None):
         if strategy not in STRATEGIES:
             raise ValueError(f"strategy must be one of {STRATEGIES}, got {strategy!r}")
         self.reduced, self.phi, self.R = reduced, phi_all, R_all
         self.nc, self.ne, self.hs, self.rows, self.i1 = n_c, n_e, hs, rows, i1
+        # complex harmonic-1 amplitudes of the excitation coordinates: [1] (cosine), or
+        # [1, -i] for a cosine row and a sine row
+        self.fe = np.ones(1, dtype=complex) if fe is None else np.asarray(fe, dtype=complex)
         self.om2 = np.ascontiguousarray(reduced.omega ** 2)
         self.Cm = reduced.modal_c
         self.cdiag = np.ascontiguousarray(np.diag(reduced.modal_c))
@@ -162,7 +165,11 @@ class LinearBuilder:
             self.rows, nc, nc, self.i1) if self.reduced.proportional else self._general(w)
         if not ok:
             raise ValueError("contact receptance is singular (dependent contact coordinates?)")
-        return LinearPart(Z, hdZ, FF[0], FF[1], np.ascontiguousarray(H[:, nc:, :nc + self.ne]))
+        F, dF = FF[0], FF[1]
+        if self.ne > 1:     # the kernels load the cosine column only: add the sine row's share
+            e = slice(nc, nc + self.ne)
+            F, dF = self._load(Z, hdZ, H[self.i1][:nc, e] @ self.fe, dH[self.i1][:nc, e] @ self.fe)
+        return LinearPart(Z, hdZ, F, dF, np.ascontiguousarray(H[:, nc:, :nc + self.ne]))
 
     def _general(self, w):
         H, dH = receptance_stack(self.phi, self.reduced.omega, self.Cm, False, self.R, self.hs * w)
@@ -195,8 +202,9 @@ class LinearBuilder:
         Ws = self.hs * w
         Hx, _ = self._receptance_rows(Ws, D, dD, self._x, self._y)
         i1, nc = self.i1, self.nc
-        Hce, dHce = self._receptance_rows(Ws[i1:i1 + 1], D[i1:i1 + 1], dD[i1:i1 + 1], np.r_[0:nc], np.r_[nc])
-        F, dF = self._load(Z, hdZ, Hce[0, :, 0], dHce[0, :, 0])
+        Hce, dHce = self._receptance_rows(Ws[i1:i1 + 1], D[i1:i1 + 1], dD[i1:i1 + 1], np.r_[0:nc],
+                                          np.r_[nc:nc + self.ne])
+        F, dF = self._load(Z, hdZ, Hce[0] @ self.fe, dHce[0] @ self.fe)
         return LinearPart(Z, hdZ, F, dF, Hx)
 
     def receptances(self, Ws, rows, cols):

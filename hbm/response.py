@@ -216,13 +216,10 @@ def build_problem(case: Case, basis: FourierBasis, transform: str):
     elif case.excitation.base is not None:
         raise CaseError(f"{case.path}: [excitation] base (support motion) needs the full solver: "
                         f"set [model] solver = \"full\"")
-    elif case.excitation.has_sine:
-        raise CaseError(f"{case.path}: [excitation] phase_deg (forces out of phase) needs the full solver "
-                        f"for now: set [model] solver = \"full\"")
     else:
         G_o = case.analysis.output_rows(st.n_dof)
-        force = case.excitation.force
-        rows = np.vstack([e.gather for e in case.elements] + [force[None, :], G_o])
+        force = np.vstack([case.excitation.force, case.excitation.force_sine])
+        rows = np.vstack([e.gather for e in case.elements] + [force, G_o])
         keep = np.flatnonzero(np.any(rows != 0.0, axis=0))
         modes = case.reduction.modes or st.default_modes()
         try:
