@@ -564,4 +564,6 @@ def load_case(path) -> Case:
         raise CaseError(f"{path}: malformed TOML: {exc}") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise CaseError(f"{path}: cannot read: {exc}") from None
+    except RecursionError:
+        raise CaseError(f"{path}: malformed TOML: arrays or tables nested too deeply") from None
     return case_from_dict(data, str(path), p.parent)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import zipfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -57,8 +58,8 @@ def _read(path: Path, key: str, names: tuple) -> ReducedModel | None:
             kept = tuple(names[i] for i in keep) if names else ()
             return ReducedModel(keep, z["omega"].copy(), z["phi"].copy(), z["modal_c"].copy(),
                                 z["residual"].copy(), int(z["n_dof"]), kept)
-    except (OSError, KeyError, ValueError):
-        return None
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
+        return None             # truncated or corrupt: recompute (and overwrite it)
 
 
 def _write(path: Path, key: str, r: ReducedModel) -> bool:

@@ -32,6 +32,7 @@ from .resonances import ResonanceStepLimit, linear_resonances
 from .stability import HillSystem, StabilityOptions, point_is_stable
 from .stability_path import hill_margin, path_stability
 from .structure import AUTO_CONDENSE_DOF
+from .budget import check_memory
 from .transforms import fftw_available, make_transform
 
 
@@ -155,6 +156,8 @@ def resolve_settings(case: Case, harmonics=None, samples=None, fmin=None, fmax=N
     if not (lo > 0 and hi > lo):
         raise CaseError(f"frequency range is empty or not positive ({lo} .. {hi} Hz)")
     tr = transform or a.transform
+    n_coef = (2 * int(np.count_nonzero(h)) + int(np.count_nonzero(h == 0)))
+    check_memory(case, n_coef, int(N), choose_solver(case) == "condensed")
     if tr == "fftw" and not fftw_available():
         raise CaseError("transform 'fftw' needs pyFFTW, which is not installed: "
                         "pip install 'hbm-friction[fftw]', or choose transform = 'numpy' or 'auto'")

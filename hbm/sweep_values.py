@@ -8,6 +8,8 @@ import numpy as np
 
 from .case import CaseError
 
+MAX_VALUES = 10000          # FRFs per sweep: a larger count is a typing slip, not a study
+
 
 def _number(text: str, what: str):
     t = text.strip()
@@ -42,6 +44,8 @@ def parse_values(text: str, log: bool = False, what: str = "--set") -> list:
         n = _number(bits[2], what)
         if not isinstance(n, int) or n < 1:
             raise CaseError(f"{what}: range count must be a positive integer, got {bits[2].strip()!r}")
+        if n > MAX_VALUES:
+            raise CaseError(f"{what}: {n} values is one FRF each; at most {MAX_VALUES} per sweep")
         if log:
             if not (a > 0 and b > 0):
                 raise CaseError(f"{what}: --log needs start and stop > 0, got {a:g}:{b:g}")
@@ -52,6 +56,8 @@ def parse_values(text: str, log: bool = False, what: str = "--set") -> list:
     if log:
         raise CaseError(f"{what}: --log applies to a range start:stop:count, not to a list")
     items = text.split(",")
+    if len(items) > MAX_VALUES:
+        raise CaseError(f"{what}: {len(items)} values is one FRF each; at most {MAX_VALUES} per sweep")
     if any(not s.strip() for s in items):
         raise CaseError(f"{what}: empty entry in the value list {text!r}")
     return [_number(s, what) for s in items]

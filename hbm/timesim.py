@@ -724,6 +724,9 @@ def _check_supported(case: Case, switch_off_at=None) -> None:
                         f"(support motion cannot stop abruptly)")
 
 
+FREQ_RANGE = (1e-9, 1e12)      # Hz: beyond, 1/(beta h^2) or h itself leaves double precision
+
+
 def _check_freq(freq_hz):
     try:
         f = float(freq_hz)
@@ -731,6 +734,9 @@ def _check_freq(freq_hz):
         raise CaseError(f"frequency must be a number, got {freq_hz!r}") from None
     if not (f > 0 and math.isfinite(f)):
         raise CaseError(f"frequency must be > 0 Hz, got {freq_hz!r}")
+    if not FREQ_RANGE[0] <= f <= FREQ_RANGE[1]:
+        raise CaseError(f"frequency {f:g} Hz is outside {FREQ_RANGE[0]:g} .. {FREQ_RANGE[1]:g} Hz: its time "
+                        f"step would overflow or underflow the integrator's arithmetic")
     return f
 
 
@@ -903,5 +909,8 @@ def timesim(case: Case, freq_hz: float, options: TimeSimOptions | None = None,
                          dataclasses.replace(opts, steps=2 * opts.steps), progress)
         mode, conv, total = "transient", True, int(periods)
     errs, est = _relative_changes(coarse, fine)
+    if not all(math.isfinite(v) for v in list(fine.h1.values()) + list(fine.max.values())):
+        raise RuntimeError(f"the integration at {f:g} Hz produced non-finite amplitudes (overflow): "
+                           f"check the model's units and the frequency")
     return TimeSimResult(f, dict(fine.h1), dict(fine.max), est, errs, int(total), bool(conv), mode,
                          coarse, fine, time.perf_counter() - t0, switch_off_at)

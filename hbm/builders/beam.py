@@ -238,6 +238,9 @@ def _offset_rows(dof_names, node, offset):
     return rows
 
 
+MAX_ELEMENTS = 20000        # 120,006 DOFs: the dense beam assembly's practical limit
+
+
 def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, Iz=None, J=None,
                      width=None, height=None, clamp=(0,), lumped_mass=False, axis=(1.0, 0.0, 0.0),
                      up=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0), points=None, point_masses=None,
@@ -278,6 +281,9 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
     n_el = int(n_elements)
     if n_el < 1 or n_el != n_elements:
         raise ValueError(f"n_elements must be a positive integer, got {n_elements}")
+    if n_el > MAX_ELEMENTS:
+        raise ValueError(f"n_elements = {n_el} is {6 * (n_el + 1)} DOFs; at most {MAX_ELEMENTS} elements per beam "
+                         f"(a finer model belongs in a model file and the condensed solver)")
     if not length > 0:
         raise ValueError(f"length must be positive, got {length}")
     rect = width is not None or height is not None
