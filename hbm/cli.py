@@ -150,8 +150,12 @@ def cmd_frf(args) -> int:
     st = res.settings
     if st.get("solver") == "condensed":
         print(f"  condensed solver: {st['n_dof']} DOFs -> {st['contact_coordinates']} contact coordinates, "
-              f"{st['modes']} modes, reduction {st['reduction_seconds']:.3f} s"
+              f"{st['modes']} modes (to {st['highest_kept_mode_hz']:.6g} Hz), reduction {st['reduction_seconds']:.3f} s"
               + (" (cached)" if st.get("reduction_cached") else ""))
+        if st.get("modes_added"):
+            from .mode_cover import MARGIN
+            print(f"  warning: {st['modes_requested']} modes stop below {MARGIN:g} x fmax: added {st['modes_added']} "
+                  f"(the omitted modes would respond inside the window)", file=sys.stderr)
     for name, pk in summary["peaks"].items():
         for p in pk:
             print(f"  peak {name}: {p['amplitude']:.6g} at {p['freq_hz']:.6g} Hz")

@@ -26,7 +26,8 @@ from .energy import energy_balance
 from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples, max_abs
 from .jumps import predict_jumps
 from .newton import newton
-from .reduction_cache import cache_path, reduce_cached
+from .mode_cover import reduce_covering
+from .reduction_cache import cache_path
 from .residual import HarmonicBalance
 from .resonances import ResonanceStepLimit, linear_resonances
 from .stability import HillSystem, StabilityOptions, point_is_stable
@@ -196,8 +197,11 @@ def choose_solver(case: Case) -> str:
     return "condensed" if st.sparse or st.n_dof > AUTO_CONDENSE_DOF else "full"
 
 
-def build_problem(case: Case, basis: FourierBasis, transform: str):
+def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: float | None = None):
     """The harmonic-balance problem of ``case`` on ``basis`` and what was chosen.
+
+    ``fmax_hz`` (default: the case's window) is the frequency the condensed solver's kept
+    modes must cover (:mod:`hbm.mode_cover`).
 
     Returns
     -------
@@ -209,6 +213,7 @@ def build_problem(case: Case, basis: FourierBasis, transform: str):
     """
     solver = choose_solver(case)
     tr = make_transform(basis, transform)
+    fmax_hz = case.analysis.freq_hz[1] if fmax_hz is None else float(fmax_hz)
     st = case.structure
     info = {"solver": solver, "n_dof": st.n_dof}
     if solver == "full":
@@ -226,11 +231,12 @@ def build_problem(case: Case, basis: FourierBasis, transform: str):
         keep = np.flatnonzero(np.any(rows != 0.0, axis=0))
         modes = case.reduction.modes or st.default_modes()
         try:
-            cr = reduce_cached(st, keep, modes, case.reduction.residual_flexibility, cache_path(case.path))
+            cr, cover = reduce_covering(st, keep, modes, case.reduction.residual_flexibility, cache_path(case.path),
+                                        fmax_hz, basis.harmonics)
             problem = CondensedHarmonicBalance(cr.reduced, case.elements, basis, force, tr, G_o)
         except ValueError as exc:
             raise CaseError(f"{case.path}: [model] condensed solver: {exc}") from exc
-        info.update(modes=int(cr.reduced.n_modes), residual_flexibility=case.reduction.residual_flexibility,
+        info.update(**cover, residual_flexibility=case.reduction.residual_flexibility,
                     contact_coordinates=int(problem.n_dof),
                     reduction_seconds=round(cr.seconds, 6), reduction_cached=cr.from_cache)
     info["n_unknowns"] = int(problem.basis.n_coef * problem.n_dof)
@@ -449,7 +455,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     """
     h, N, lo, hi, tr = resolve_settings(case, harmonics, samples, fmin, fmax, transform)
     basis = FourierBasis(h, N)
-    problem, info = build_problem(case, basis, tr)
+    problem, info = build_problem(case, basis, tr, hi)
     stability = bool(stability)
     w_lo, w_hi = 2 * np.pi * lo, 2 * np.pi * hi
     t0 = time.perf_counter()
@@ -609,7 +615,7 @@ def solve_at(case: Case, freq_hz: float, harmonics=None, samples=None, transform
     """
     h, N, _, _, tr = resolve_settings(case, harmonics, samples, None, None, transform)
     basis = FourierBasis(h, N)
-    problem, _ = build_problem(case, basis, tr)
+    problem, _ = build_problem(case, basis, tr, max(float(freq_hz), case.analysis.freq_hz[1]))
     w = 2 * np.pi * float(freq_hz)
     xscale = _unknown_scale(problem, case, w * 0.9, w * 1.1)
     X, _ = _first_point(problem, case, w, xscale, _residual_scale(problem, w))
