@@ -371,6 +371,9 @@ def reduce_model(M, K, *, n_modes=None, residual_flexibility=True, modal_damping
             lam, Phi = sla.eigh(K, M, subset_by_index=[0, n_modes - 1])
         except np.linalg.LinAlgError:
             raise ValueError("mass matrix must be symmetric positive definite") from None
+    if lam.min() < -1e-9 * max(abs(lam.max()), 1e-300):
+        raise ValueError(f"stiffness matrix must be positive semi-definite (negative stiffness?): "
+                         f"eigenvalue {lam.min():.3g} (rad/s)^2")
     if lam.min() <= 1e-12 * max(abs(lam.max()), 1e-300):
         raise ValueError("stiffness matrix is singular (free-free structure?): clamp it first")
     Phi = Phi / np.sqrt(np.einsum("ir,ir->r", Phi, M @ Phi))
@@ -388,11 +391,18 @@ def reduce_model(M, K, *, n_modes=None, residual_flexibility=True, modal_damping
         if a.shape != (2,):
             raise ValueError("rayleigh must be a pair [a, b] (C = a M + b K)")
         Cm = np.diag(a[0] + a[1] * lam)
+        if np.any(np.diag(Cm) < 0):
+            raise ValueError(f"rayleigh = [{a[0]:g}, {a[1]:g}] gives negative damping (a + b w^2 < 0 for a "
+                             f"kept mode): damping must be positive semi-definite")
     elif damping is not None:
         C = damping if sp.issparse(damping) else np.asarray(damping, dtype=float)
         _check_square("damping", C, n)
         Cm = Phi.T @ (C @ Phi)
         Cm = 0.5 * (Cm + Cm.T)
+        cm = np.linalg.eigvalsh(Cm)
+        if cm[0] < -1e-9 * max(abs(cm).max(), 1e-300):
+            raise ValueError("damping matrix must be positive semi-definite (negative damping?): "
+                             f"its modal projection has eigenvalue {cm[0]:.3g}")
     else:
         Cm = np.zeros((n_modes, n_modes))
 

@@ -27,6 +27,7 @@ the worker) is recorded with its message and the sweep goes on.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -37,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .case import Case, CaseError, case_from_dict, load_case
+from .atomic import FolderLock, write_atomic
 from .casekeys import find_ratio_key, get_key, scale_excitation, set_key
 from .sweep_plot import write_plot
 from .sweep_values import parse_assignment, parse_values, value_label
@@ -128,10 +130,12 @@ def _source(case):
     return c.raw, c.path, str(Path(c.path).parent)
 
 
-def _fingerprint(raw: dict, overrides: FRFOverrides) -> str:
+def _fingerprint(raw: dict, overrides: FRFOverrides, model: str = "") -> str:
+    """Hash of the case tree, the overrides, the model's matrices (``model``: the structure's
+    fingerprint, so a model file that changed on disk is a different run) and the version
+    (a finished run of another version is not reused)."""
     from . import __version__
-    # the version is part of it: a finished run of another version is not reused
-    text = json.dumps({"case": raw, "overrides": asdict(overrides), "version": __version__},
+    text = json.dumps({"case": raw, "overrides": asdict(overrides), "version": __version__, "model": model},
                       sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
@@ -163,11 +167,11 @@ def make_tasks(case, key: str, values, overrides: FRFOverrides = FRFOverrides(),
             new = set_key(raw, key, v)
             changed = {key: v}
         try:
-            case_from_dict(new, path, Path(base_dir))
+            checked = case_from_dict(new, path, Path(base_dir))
         except CaseError as exc:
             raise CaseError(f"sweep {key}={v!r}: {exc}") from None
         tasks.append(RunTask(i, v, new, path, base_dir, overrides, f"{i:03d}_{value_label(v)}",
-                             _fingerprint(new, overrides), changed))
+                             _fingerprint(new, overrides, checked.structure.fingerprint()), changed))
     return tasks
 
 
@@ -212,10 +216,7 @@ def _row(summary: dict, reused: bool) -> dict:
 
 
 def _write_json_atomic(path: Path, data: dict) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w") as fh:
-        json.dump(data, fh, indent=2, default=str)
-    os.replace(tmp, path)
+    write_atomic(path, json.dumps(data, indent=2, default=str))
 
 
 def _save_run(rundir: Path, out: dict) -> None:
@@ -224,7 +225,7 @@ def _save_run(rundir: Path, out: dict) -> None:
     if done.exists():
         done.unlink()
     if out["csv"] is not None:
-        (rundir / "frf.csv").write_text(out["csv"])
+        write_atomic(rundir / "frf.csv", out["csv"])
     _write_json_atomic(done, out["summary"])
 
 
@@ -238,6 +239,25 @@ def finished_run(rundir: Path, task: RunTask) -> dict | None:
 
 
 # ---------------------------------------------------------------------------- driver
+
+def _die_with_parent(parent: int) -> None:
+    """Worker start: end this worker when the sweep's process ends, even by SIGKILL (which
+    leaves no chance to shut the pool down; the workers waited on their pipe for ever)."""
+    import signal
+    import threading
+    import time
+    try:
+        import ctypes
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+    threading.Thread(target=watch, daemon=True).start()
+
 
 def _executor(options: SweepOptions, n_tasks: int):
     """``(submit, completed, close)`` over a Dask client or a local process pool."""
@@ -253,7 +273,8 @@ def _executor(options: SweepOptions, n_tasks: int):
             raise CaseError(f"--dask: cannot connect to scheduler {options.dask!r}: {exc}") from None
         return (lambda t: client.submit(run_task, t, pure=False), dask_completed,
                 lambda: client.close())
-    pool = ProcessPoolExecutor(max_workers=max(1, min(options.jobs or os.cpu_count() or 1, n_tasks)))
+    pool = ProcessPoolExecutor(max_workers=max(1, min(options.jobs or os.cpu_count() or 1, n_tasks)),
+                               initializer=_die_with_parent, initargs=(os.getpid(),))
     return (lambda t: pool.submit(run_task, t), as_completed,
             lambda: pool.shutdown(wait=True, cancel_futures=True))
 
@@ -291,6 +312,12 @@ def sweep(case, key: str, values, outdir=None, *, ratio_key: str | None = None,
         if out.exists() and not out.is_dir():
             raise CaseError(f"output folder {str(out)!r} exists and is not a folder")
         (out / "runs").mkdir(parents=True, exist_ok=True)
+    with FolderLock(out) if out is not None else contextlib.nullcontext():
+        return _sweep_into(tasks, key, out, ratio_key, options, progress)
+
+
+def _sweep_into(tasks, key, out, ratio_key, options, progress) -> SweepResult:
+    """:func:`sweep` once its tasks are made and its folder is held."""
     outputs = list(case_from_dict(tasks[0].raw, tasks[0].path, Path(tasks[0].base_dir)).analysis.outputs)
     rows, todo = [], []
     for t in tasks:

@@ -22,10 +22,11 @@ from __future__ import annotations
 
 import csv
 import io
-import os
 from pathlib import Path
 
 import numpy as np
+
+from .atomic import write_atomic
 
 OPTIMUM_QUANTITY = "receptance"
 
@@ -80,6 +81,4 @@ def write_summary_csv(path: Path, rows: list, outputs: list) -> None:
                       else ["", "", "", ""])
         cells += [r["n_points"], f"{r['solve_seconds']:.4g}", r["message"]]
         w.writerow(cells)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(buf.getvalue())
-    os.replace(tmp, path)
+    write_atomic(path, buf.getvalue())

@@ -2,6 +2,7 @@
 (after deleting a run and after killing the process), force ratio, failures."""
 import csv
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -236,3 +237,76 @@ def test_sweep_accepts_a_loaded_case_and_a_dict():
     a = sweep(case, "excitation.amplitude", [5.0], None, overrides=H3, options=SERIAL)
     b = sweep(case.raw, "excitation.amplitude.0", [5.0], None, overrides=H3, options=SERIAL)
     assert a.rows[0]["peak"]["x"]["amplitude"] == b.rows[0]["peak"]["x"]["amplitude"] > 0
+
+
+def test_resume_recomputes_when_the_model_file_changed(tmp_path):
+    """The fingerprint covers the model file's matrices, not only the TOML naming it."""
+    np.savez(tmp_path / "m.npz", M=np.array([[1.0]]), K=np.array([[4e4]]), C=np.array([[2.0]]))
+    case = tmp_path / "case.toml"
+    case.write_text(RIG.read_text().replace('mass      = [[1.0]]\nstiffness = [[4.0e4]]\ndamping   = [[2.0]]',
+                                            'file = "m.npz"'))
+    assert 'file = "m.npz"' in case.read_text()
+    out = tmp_path / "out"
+    opts = SweepOptions(jobs=1, plot=False, resume=True)
+    first = sweep(str(case), "element.0.slip_force", [1.0, 4.0], out, overrides=H3, options=opts)
+    again = sweep(str(case), "element.0.slip_force", [1.0, 4.0], out, overrides=H3, options=opts)
+    assert [r["reused"] for r in again.rows] == [1, 1]
+    np.savez(tmp_path / "m.npz", M=np.array([[1.0]]), K=np.array([[8e4]]), C=np.array([[2.0]]))
+    changed = sweep(str(case), "element.0.slip_force", [1.0, 4.0], out, overrides=H3, options=opts)
+    assert [r["reused"] for r in changed.rows] == [0, 0]
+    f0 = [r["peak"]["x"]["freq_hz"] for r in first.rows]
+    f1 = [r["peak"]["x"]["freq_hz"] for r in changed.rows]
+    assert all(b > a * 1.2 for a, b in zip(f0, f1))      # the stiffer model's peaks moved up
+
+
+def test_a_folder_in_use_is_refused_and_a_stale_lock_taken_over(tmp_path):
+    from hbm.atomic import LOCK_NAME
+    from hbm.case import CaseError
+    out = tmp_path / "out"
+    out.mkdir()
+    other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        (out / LOCK_NAME).write_text(str(other.pid))
+        with pytest.raises(CaseError, match=f"in use by another run \\(process {other.pid}\\)"):
+            sweep(str(RIG), "element.0.slip_force", [1.0], out, overrides=H3, options=SERIAL)
+    finally:
+        other.kill()
+        other.wait()
+    res = sweep(str(RIG), "element.0.slip_force", [1.0], out, overrides=H3, options=SERIAL)  # now stale
+    assert res.ok and not (out / LOCK_NAME).exists()
+    leftovers = [p.name for p in out.rglob("*") if p.name.endswith(".tmp")]
+    assert leftovers == []
+
+
+def _running(pid):
+    """True while ``pid`` exists and is not a zombie."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def test_workers_end_with_a_killed_sweep(tmp_path):
+    """SIGKILL of the sweep leaves no chance to shut its pool down: the workers now watch
+    their parent and end with it (they used to wait on their pipe for ever)."""
+    args = [sys.executable, "-m", "hbm", "sweep", str(RIG), "--set", "element.0.slip_force=0.5:60:200",
+            "-o", str(tmp_path / "o"), "--harmonics", "15", "--jobs", "2", "-q"]
+    p = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT)
+    t0 = time.time()
+    kids = []
+    while len(kids) < 2 and time.time() - t0 < 60:
+        time.sleep(0.2)
+        r = subprocess.run(["pgrep", "-P", str(p.pid)], capture_output=True, text=True)
+        kids = [int(k) for k in r.stdout.split()]
+    assert len(kids) == 2 and p.poll() is None
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    t0 = time.time()
+    alive = kids
+    while alive and time.time() - t0 < 10:
+        time.sleep(0.2)
+        alive = [k for k in kids if _running(k)]
+    for k in alive:
+        os.kill(k, signal.SIGKILL)
+    assert alive == []
