@@ -35,10 +35,15 @@ DENSE_EIG_MAX = 1000         # sparse models up to this size are reduced by a de
 @dataclass(frozen=True)
 class Damping:
     """Damping as specified: ``kind`` in ``none``, ``matrix`` (``value`` (n, n), dense or
-    sparse), ``rayleigh`` (``value`` = (a, b)) or ``modal`` (``value`` = ratio(s))."""
+    sparse), ``rayleigh`` (``value`` = (a, b)) or ``modal`` (``value`` = ratio(s)).
+
+    ``origin`` names where a derived matrix came from (a modal specification turned into a
+    matrix when DOFs are appended): the fingerprint uses it, because the derived matrix goes
+    through an eigen-solve whose last bits depend on the BLAS thread count."""
 
     kind: str = "none"
     value: object = None
+    origin: str = ""
 
     def __post_init__(self):
         if self.kind not in DAMPING_KINDS:
@@ -163,7 +168,8 @@ class Structure:
             a, b = d.value
             damping = Damping("matrix", blk(a * self.M + b * self.K, zero))
         else:
-            damping = Damping("matrix", blk(self.linear_model().C, zero))
+            damping = Damping("matrix", blk(self.linear_model().C, zero),
+                              origin=f"modal of {self.fingerprint()} padded by {m}")
         return Structure(blk(self.M, M_add), blk(self.K, K_add), damping, old + names, dict(self.points))
 
     @property
@@ -242,7 +248,9 @@ class Structure:
         _matrix_bytes(h, self.K)
         h.update(self.damping.kind.encode())
         v = self.damping.value
-        if self.damping.kind == "matrix":
+        if self.damping.origin:
+            h.update(self.damping.origin.encode())
+        elif self.damping.kind == "matrix":
             _matrix_bytes(h, v)
         elif v is not None:
             h.update(np.asarray(v, dtype=float).tobytes())
