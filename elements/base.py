@@ -225,12 +225,17 @@ def require_keys(spec: dict, allowed, required, where: str) -> None:
             raise ValueError(f"{where}: missing key {k!r}")
 
 
+MAGNITUDE_MAX = 1e100      # no physical input in SI units is larger; beyond, products overflow
+
+
 def _number(name, value):
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ValueError(f"{name} must be a number, got {value!r}")
     v = float(value)
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite, got {value!r}")
+    if abs(v) > MAGNITUDE_MAX:
+        raise ValueError(f"{name} = {value!r} is out of range (|value| > {MAGNITUDE_MAX:g}: products overflow)")
     return v
 
 

@@ -46,7 +46,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from elements import ELEMENTS
-from elements.base import coordinate_row, did_you_mean
+from elements.base import MAGNITUDE_MAX, coordinate_row, did_you_mean
 
 from .fourier import parse_harmonics, min_samples, default_samples
 from .linear import LinearModel
@@ -171,6 +171,9 @@ def _matrix(value, name, path):
         A = np.diag(A)
     if A.ndim != 2:
         raise CaseError(f"{path}: [model] {name} must be a matrix (list of rows)")
+    if np.any(np.abs(A[np.isfinite(A)]) > MAGNITUDE_MAX):
+        raise CaseError(f"{path}: [model] {name} has entries above {MAGNITUDE_MAX:g} in magnitude "
+                        f"(products would overflow)")
     return A
 
 
@@ -180,6 +183,8 @@ def _number(value, name, path, *, positive=False, integer=False):
         ok = ok and isinstance(value, int)
     if not ok or not math.isfinite(value):
         raise CaseError(f"{path}: {name} must be {'an integer' if integer else 'a number'}, got {value!r}")
+    if abs(value) > MAGNITUDE_MAX:
+        raise CaseError(f"{path}: {name} = {value!r} is out of range (|value| > {MAGNITUDE_MAX:g})")
     if positive and value <= 0:
         raise CaseError(f"{path}: {name} must be > 0, got {value!r}")
     return value

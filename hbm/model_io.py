@@ -103,7 +103,11 @@ def _real(A, name, path):
         raise ValueError(f"{path}: {name} holds booleans, not numbers")
     if kind not in "fiu":
         raise ValueError(f"{path}: {name} holds {A.dtype} values, not numbers")
-    return A.astype(float) if sp.issparse(A) else np.asarray(A, dtype=float)
+    A = A.astype(float) if sp.issparse(A) else np.asarray(A, dtype=float)
+    data = A.data if sp.issparse(A) else A
+    if np.any(np.abs(data[np.isfinite(data)]) > 1e100):
+        raise ValueError(f"{path}: {name} has entries above 1e+100 in magnitude (products would overflow)")
+    return A
 
 
 def read_npz(path) -> ModelData:
