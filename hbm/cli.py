@@ -286,10 +286,13 @@ def cmd_sweep(args) -> int:
 
 def cmd_rigs(args) -> int:
     """Print each shipped case file's path and name, so a rig can be run from anywhere."""
+    import importlib.util
     import pathlib
     import tomllib
-    import rigs
-    for path in sorted(pathlib.Path(rigs.__file__).parent.glob("*.toml")):
+    spec = importlib.util.find_spec("rigs")      # located, not imported: the library needs no example
+    if spec is None or not spec.submodule_search_locations:
+        raise CaseError("the shipped rigs are not installed")
+    for path in sorted(pathlib.Path(list(spec.submodule_search_locations)[0]).glob("*.toml")):
         with open(path, "rb") as fh:
             name = tomllib.load(fh).get("name", path.stem)
         print(f"{path}  {name}")
@@ -313,6 +316,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("hbm: interrupted\n")
         return 130
+    except BrokenPipeError:          # output piped into e.g. head, which closed early: not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":

@@ -210,6 +210,9 @@ def _ints(line):
     return [int(t) for t in s.split()]
 
 
+OP4_BYTES_PER_FILE_BYTE = 6      # text, its lines, and the parsed entries, per byte of the file
+
+
 def read_op4(path) -> dict:
     """Read all matrices of an ASCII OP4 file.
 
@@ -222,6 +225,12 @@ def read_op4(path) -> dict:
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"OP4 file not found: {path}")
+    from .budget import MEMORY_SHARE, machine_memory
+    need = OP4_BYTES_PER_FILE_BYTE * path.stat().st_size
+    if need > MEMORY_SHARE * machine_memory():
+        raise ValueError(f"{path}: an ASCII OP4 file of {path.stat().st_size / 1e9:.3g} GB needs about "
+                         f"{need / 1e9:.3g} GB to read (this machine has {machine_memory() / 1e9:.3g} GB): "
+                         f"write the matrices sparse, or use Matrix Market files")
     lines = path.read_text().splitlines()
     out = {}
     i = 0

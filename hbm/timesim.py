@@ -79,6 +79,7 @@ import numpy as np
 
 from elements.kernels import law_step, law_init
 
+from .budget import MEMORY_SHARE, machine_memory
 from .case import Case, CaseError
 
 
@@ -768,6 +769,10 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     K = np.ascontiguousarray(case.model.K, dtype=float)
     F2 = np.ascontiguousarray(np.vstack([case.excitation.force, case.excitation.force_sine]), dtype=float)
     rows = N + 1 if check else periods * N + 1
+    need = 8.0 * rows * (n + 3 * n_f) + 8.0 * 4 * n * n
+    if need > MEMORY_SHARE * machine_memory():
+        raise CaseError(f"the time history of {rows} steps needs about {need / 1e9:.3g} GB "
+                        f"(this machine has {machine_memory() / 1e9:.3g} GB): fewer steps or periods")
     rec_q = np.zeros((rows, n))
     rec_f = np.zeros((rows, n_f))
     rec_u = np.zeros((rows, n_f))

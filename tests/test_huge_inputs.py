@@ -38,6 +38,7 @@ outputs = {y = "b.n3.uy"}
     (["frf", str(ROOT / "rigs" / "upd_rig.toml"), "--harmonics", "3000"], "GB of memory"),
     (["sweep", SDOF, "--set", "element.0.slip_force=1:2:100000000"], "at most 10000 per sweep"),
     (["timesim", SDOF, "--freq-hz", "1e-300"], "outside 1e-09 .. 1e+12 Hz"),
+    (["timesim", SDOF, "--freq-hz", "30", "--periods", "100000000"], "GB (this machine has"),
 ])
 def test_refused_in_one_line(tmp_path, capsys, argv, needle):
     assert main(argv + ["-o", str(tmp_path / "o"), "-q"]) == 2
@@ -67,3 +68,17 @@ def test_corrupt_reduction_cache_is_recomputed(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "(cached)" not in out and cache.stat().st_size > 1000       # recomputed and rewritten
     assert main(argv) == 0 and "(cached)" in capsys.readouterr().out
+
+
+def test_an_op4_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch):
+    """The reader holds the text and the parsed entries (several times the file): a file that
+    cannot fit is refused before reading, by its size (the machine's memory is shrunk here)."""
+    import hbm.budget
+    from hbm.model_io import read_op4, write_op4
+    import numpy as np
+    p = tmp_path / "m.op4"
+    write_op4(p, {"KAA": np.eye(40), "MAA": np.eye(40)})
+    assert set(read_op4(p)) == {"KAA", "MAA"}
+    monkeypatch.setattr(hbm.budget, "machine_memory", lambda: 2.0 * p.stat().st_size)
+    with pytest.raises(ValueError, match="needs about .* GB to read"):
+        read_op4(p)
