@@ -5,7 +5,8 @@ Top panel, log scale: per output (one colour each) the first-harmonic receptance
 scale (:func:`hbm.sweep_summary.excitation_scale`: N under a force, so m/N for a displacement
 output; m under support motion, so the ratio is a transmissibility).  Points that Hill's
 method finds unstable are drawn dotted and grey-backed; the jumps of slow sweeps are arrows
-(up-sweep red, down-sweep blue; a jump with no stable landing ends in a cross); folds are
+(up-sweep red, down-sweep blue; a jump with no stable landing ends in a cross); a shaded
+band is the estimated truncation error of the first harmonic (:mod:`hbm.truncation`); folds are
 faint vertical lines.  A lower panel, when the case asks for element outputs
 (``"ELEMENT.QUANTITY"``, e.g. a contact's slip fraction or normal load), draws them against
 the same frequency axis.
@@ -30,7 +31,11 @@ def _runs(stable: np.ndarray) -> list:
     return out
 
 
-def _draw_output(ax, freq, h1, mx, runs, colour, name):
+def _draw_output(ax, freq, h1, mx, runs, colour, name, err=None):
+    if err is not None and np.isfinite(err).any():
+        e = np.nan_to_num(err)
+        ax.fill_between(freq, h1 * np.maximum(1 - e, 1e-3), h1 * (1 + e), color=colour, alpha=0.2, lw=0,
+                        label=f"{name}: estimated error")
     for a, b, ok in runs:
         sl = slice(a, b + 1)
         ax.plot(freq[sl], h1[sl], "-" if ok else ":", lw=1.6 if ok else 2.0, color=colour,
@@ -76,7 +81,8 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
     runs = _runs(stable)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, (name, o) in enumerate(res.outputs.items()):
-        _draw_output(ax, res.freq_hz, o.h1 / scale, o.max / scale, runs, colours[k % len(colours)], name)
+        _draw_output(ax, res.freq_hz, o.h1 / scale, o.max / scale, runs, colours[k % len(colours)], name,
+                     getattr(o, "err", None))
         if jumps and jumps.get(name):
             _draw_jumps(ax, jumps[name], scale)
     if res.stable is not None and not stable.all():

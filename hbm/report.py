@@ -1,6 +1,7 @@
 """Write an FRF to disk: ``frf.csv``, ``summary.json`` and ``frf.png`` (CLI contract of DESIGN.md).
 
-``frf.csv`` columns: ``freq_hz``, then ``NAME_h1`` and ``NAME_max`` per DOF output, then one
+``frf.csv`` columns: ``freq_hz``, then ``NAME_h1``, ``NAME_max`` and ``NAME_err`` (estimated
+relative error of ``NAME_h1`` from the harmonic truncation, when computed) per DOF output, then one
 column ``NAME`` per element output (a per-period scalar such as ``contact.slip_fraction``), then
 ``stable`` (1/0, empty when not computed); rows follow the continuation path.  ``summary.json``
 adds ``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.jumps`) when
@@ -55,12 +56,14 @@ def format_csv(res) -> str:
     enames = list(getattr(res, "element_outputs", {}))
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")] + enames + ["stable"])
+    has_err = bool(names) and all(getattr(res.outputs[n], "err", None) is not None for n in names)
+    keys = ("h1", "max", "err") if has_err else ("h1", "max")
+    w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in keys] + enames + ["stable"])
     for i, f in enumerate(res.freq_hz):
         row = [f"{f:.10g}"]
         for n in names:
             o = res.outputs[n]
-            row += [f"{o.h1[i]:.10g}", f"{o.max[i]:.10g}"]
+            row += [f"{o.h1[i]:.10g}", f"{o.max[i]:.10g}"] + ([f"{o.err[i]:.3g}"] if has_err else [])
         row += [f"{res.element_outputs[n][i]:.10g}" for n in enames]
         row.append("" if res.stable is None else str(int(bool(res.stable[i]))))
         w.writerow(row)

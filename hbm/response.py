@@ -27,6 +27,7 @@ from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples
 from .jumps import predict_jumps
 from .newton import newton
 from .mode_cover import reduce_covering
+from .truncation import MAX_UNKNOWNS, WARN_ERROR, richer_basis, truncation_errors
 from .reduction_cache import cache_path
 from .residual import HarmonicBalance
 from .resonances import ResonanceStepLimit, linear_resonances
@@ -39,10 +40,13 @@ from .transforms import fftw_available, make_transform
 
 @dataclass(frozen=True)
 class OutputSeries:
-    """Per-point amplitudes of one output: ``h1`` and ``max`` (n_points,)."""
+    """Per-point amplitudes of one output: ``h1`` and ``max`` (n_points,), and ``err``, the
+    estimated relative error of ``h1`` from the harmonic truncation (:mod:`hbm.truncation`;
+    None when not computed)."""
 
     h1: np.ndarray
     max: np.ndarray
+    err: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -112,6 +116,8 @@ class FRFResult:
         cols = {"freq_hz": self.freq_hz}
         for name, o in self.outputs.items():
             cols[f"{name}_h1"], cols[f"{name}_max"] = o.h1, o.max
+            if o.err is not None:
+                cols[f"{name}_err"] = o.err
         cols.update(self.element_outputs)
         cols["stable"] = (np.full(self.freq_hz.size, np.nan) if self.stable is None
                           else np.asarray(self.stable, dtype=float))
@@ -424,7 +430,7 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
 
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
         progress=None, options: ArclengthOptions | None = None, stability: bool = True,
-        stability_options: StabilityOptions | None = None) -> FRFResult:
+        stability_options: StabilityOptions | None = None, error_estimate: bool = True) -> FRFResult:
     """Trace the FRF of ``case``.
 
     Parameters
@@ -446,6 +452,8 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         Decide the stability of every point by Hill's method (``FRFResult.stable``);
         ``False`` leaves ``stable`` as ``None``.
     stability_options : StabilityOptions, optional
+    error_estimate : bool
+        Estimate every point's truncation error (``outputs[name].err``, :mod:`hbm.truncation`).
 
     Returns
     -------
@@ -546,9 +554,41 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
                 return output_amplitudes(basis, recover_outputs(problem, case, X, 2 * np.pi * f)[:, i])[0]
             jumps[name] = predict_jumps(freq_hz, outputs[name].h1, stable, folds, refine=refine)
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
+    if error_estimate and Xs.shape[0]:
+        outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings)
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
                      jumps, eouts, Ys)
+
+
+def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
+    """``outputs`` with the truncation error estimate of every point (:mod:`hbm.truncation`);
+    ``settings`` gains ``error_estimate`` (computed, richer H, largest error per output) and,
+    above ``WARN_ERROR``, a ``truncation_warning``."""
+    t0 = time.perf_counter()
+    rb = richer_basis(problem.basis)
+    rp, _ = build_problem(case, rb, "auto", fmax_hz)
+    E = truncation_errors(problem, rp, Xs, ws)
+    info = {"computed": E is not None, "richer_harmonics": int(rb.harmonics.max()),
+            "seconds": round(time.perf_counter() - t0, 6)}
+    if E is None:
+        info["reason"] = f"the richer problem has {rp.n_unknowns} unknowns (> {MAX_UNKNOWNS})"
+        settings["error_estimate"] = info
+        return outputs
+    out, worst = {}, {}
+    for i, (name, o) in enumerate(outputs.items()):
+        out[name] = OutputSeries(o.h1, o.max, E[:, i])
+        k = int(np.nanargmax(E[:, i])) if np.isfinite(E[:, i]).any() else 0
+        worst[name] = {"error": float(E[k, i]), "freq_hz": float(ws[k] / (2 * np.pi))}
+    info["max"] = worst
+    settings["error_estimate"] = info
+    bad = {n: v for n, v in worst.items() if v["error"] > WARN_ERROR}
+    if bad:
+        n, v = max(bad.items(), key=lambda kv: kv[1]["error"])
+        settings["truncation_warning"] = (
+            f"estimated error of {n} up to {v['error']:.1%} at {v['freq_hz']:.6g} Hz from the harmonic "
+            f"truncation (H = {int(problem.basis.harmonics.max())}): raise harmonics")
+    return out
 
 
 def _path_verdicts(problem, Xs, ws, segments, options):
