@@ -7,7 +7,8 @@ output; m under support motion, so the ratio is a transmissibility).  Points tha
 method finds unstable are drawn dotted and grey-backed; the jumps of slow sweeps are arrows
 (up-sweep red, down-sweep blue; a jump with no stable landing ends in a cross); a shaded
 band is the estimated truncation error of the first harmonic (:mod:`hbm.truncation`); folds are
-faint vertical lines.  A lower panel, when the case asks for element outputs
+faint vertical lines.  A panel below draws that estimated error on a log scale with 1 %
+marked; a lower panel, when the case asks for element outputs
 (``"ELEMENT.QUANTITY"``, e.g. a contact's slip fraction or normal load), draws them against
 the same frequency axis.
 """
@@ -34,8 +35,7 @@ def _runs(stable: np.ndarray) -> list:
 def _draw_output(ax, freq, h1, mx, runs, colour, name, err=None):
     if err is not None and np.isfinite(err).any():
         e = np.nan_to_num(err)
-        ax.fill_between(freq, h1 * np.maximum(1 - e, 1e-3), h1 * (1 + e), color=colour, alpha=0.2, lw=0,
-                        label=f"{name}: estimated error")
+        ax.fill_between(freq, h1 * np.maximum(1 - e, 1e-3), h1 * (1 + e), color=colour, alpha=0.2, lw=0)
     for a, b, ok in runs:
         sl = slice(a, b + 1)
         ax.plot(freq[sl], h1[sl], "-" if ok else ":", lw=1.6 if ok else 2.0, color=colour,
@@ -53,6 +53,18 @@ def _draw_jumps(ax, jumps, scale):
                 continue
             ax.annotate("", xy=(j["from_hz"], j["amplitude_after"] / scale), xytext=(j["from_hz"], y0),
                         arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.5})
+
+
+def _draw_errors(ax, freq, errs, colours):
+    """Estimated relative error of each output's first harmonic, log scale, 1 % marked."""
+    for k, (name, e) in enumerate(errs.items()):
+        ax.semilogy(freq, np.maximum(np.nan_to_num(e, nan=1e-16), 1e-16), lw=1.0, color=colours[k % len(colours)],
+                    label=name)
+    ax.axhline(0.01, color="tab:red", lw=0.8, ls="--", label="1 %")
+    ax.set_ylim(bottom=max(1e-8, ax.get_ylim()[0]))
+    ax.set_ylabel("estimated error")
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=7, ncol=3)
 
 
 def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N", jumps=None) -> None:
@@ -74,8 +86,11 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     elem = getattr(res, "element_outputs", {}) or {}
-    fig, axes = plt.subplots(2 if elem else 1, 1, figsize=(8, 7.5 if elem else 5), sharex=True, squeeze=False,
-                             gridspec_kw={"height_ratios": [2.2, 1]} if elem else None)
+    errs = {n: o.err for n, o in res.outputs.items() if getattr(o, "err", None) is not None}
+    panels = ["main"] + (["err"] if errs else []) + (["elem"] if elem else [])
+    ratios = {"main": 2.4, "err": 0.8, "elem": 1.0}
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 4.6 + 1.6 * (len(panels) - 1)), sharex=True,
+                             squeeze=False, gridspec_kw={"height_ratios": [ratios[p] for p in panels]})
     ax = axes[0, 0]
     stable = np.ones(res.freq_hz.size, dtype=bool) if res.stable is None else np.asarray(res.stable)
     runs = _runs(stable)
@@ -99,8 +114,10 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
     ax.set_title(title, fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
+    if errs:
+        _draw_errors(axes[panels.index("err"), 0], res.freq_hz, errs, colours)
     if elem:
-        ex = axes[1, 0]
+        ex = axes[panels.index("elem"), 0]
         for name, v in elem.items():
             ex.plot(res.freq_hz, v, lw=1.2, label=name)
         ex.set_ylabel("element outputs")
