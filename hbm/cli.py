@@ -168,11 +168,14 @@ def cmd_frf(args) -> int:
                          "check with hbm timesim)" if j["amplitude_after"] is None else f"{j['amplitude_after']:.6g}")
                 print(f"  jump {name} (sweep {way}) at {j['from_hz']:.6g} Hz: "
                       f"{j['amplitude_before']:.6g} -> {after}")
-    for key in ("stability_warning", "closure_warning", "truncation_warning"):
+    for key in ("stability_warning", "closure_warning", "truncation_warning", "harmonics_note"):
         if st.get(key):
             print(f"  warning: {st[key]}", file=sys.stderr)
     if summary["max_energy_error"] is not None:
         print(f"  max energy-balance error {summary['max_energy_error']:.2e}")
+    if st.get("stuck_points"):
+        print(f"  note: at {st['stuck_points']} points a contact sticks for the whole period: its slider offset, "
+              f"hence the mean and max |y|, is one of a family of periodic solutions (column stuck_contacts)")
     for name, v in (st.get("error_estimate") or {}).get("max", {}).items():
         print(f"  largest estimated error of {name}_h1 {v['error']:.1e} at {v['freq_hz']:.6g} Hz (harmonic truncation)")
     print(f"  wrote {args.out}/frf.csv, frf.png, summary.json")

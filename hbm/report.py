@@ -3,6 +3,8 @@
 ``frf.csv`` columns: ``freq_hz``, then ``NAME_h1``, ``NAME_max`` and ``NAME_err`` (estimated
 relative error of ``NAME_h1`` from the harmonic truncation, when computed) per DOF output, then one
 column ``NAME`` per element output (a per-period scalar such as ``contact.slip_fraction``), then
+``stuck_contacts`` (hysteretic contacts stuck for the whole period, :mod:`hbm.stuck`; absent
+without such contacts), then
 ``stable`` (1/0, empty when not computed); rows follow the continuation path.  ``summary.json``
 adds ``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.jumps`) when
 the stability was computed.  ``frf.png``: :mod:`hbm.frf_plot`.
@@ -58,13 +60,17 @@ def format_csv(res) -> str:
     w = csv.writer(buf, lineterminator="\n")
     has_err = bool(names) and all(getattr(res.outputs[n], "err", None) is not None for n in names)
     keys = ("h1", "max", "err") if has_err else ("h1", "max")
-    w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in keys] + enames + ["stable"])
+    stuck = getattr(res, "stuck", None)
+    w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in keys] + enames
+               + ([] if stuck is None else ["stuck_contacts"]) + ["stable"])
     for i, f in enumerate(res.freq_hz):
         row = [f"{f:.10g}"]
         for n in names:
             o = res.outputs[n]
             row += [f"{o.h1[i]:.10g}", f"{o.max[i]:.10g}"] + ([f"{o.err[i]:.3g}"] if has_err else [])
         row += [f"{res.element_outputs[n][i]:.10g}" for n in enames]
+        if stuck is not None:
+            row.append(str(int(stuck[i])))
         row.append("" if res.stable is None else str(int(bool(res.stable[i]))))
         w.writerow(row)
     return buf.getvalue()

@@ -27,7 +27,8 @@ from .fourier import FourierBasis, parse_harmonics, min_samples, default_samples
 from .jumps import predict_jumps
 from .newton import newton
 from .mode_cover import reduce_covering
-from .truncation import MAX_UNKNOWNS, WARN_ERROR, richer_basis, truncation_errors
+from .stuck import stuck_contacts
+from .truncation import MAX_UNKNOWNS, SMALL_ERROR, WARN_ERROR, richer_basis, truncation_errors
 from .reduction_cache import cache_path
 from .residual import HarmonicBalance
 from .resonances import ResonanceStepLimit, linear_resonances
@@ -94,6 +95,9 @@ class FRFResult:
     element_outputs: dict = field(default_factory=dict)
     Y: np.ndarray | None = None
     """Output coefficients of every point, (n_points, n_coef, n_outputs), in ``outputs`` order."""
+    stuck: np.ndarray | None = None
+    """Hysteretic contacts stuck for the whole period at every point (:mod:`hbm.stuck`; a
+    point with one has a family of periodic solutions), None without such contacts."""
 
     @property
     def ok(self) -> bool:
@@ -119,6 +123,8 @@ class FRFResult:
             if o.err is not None:
                 cols[f"{name}_err"] = o.err
         cols.update(self.element_outputs)
+        if self.stuck is not None:
+            cols["stuck_contacts"] = self.stuck
         cols["stable"] = (np.full(self.freq_hz.size, np.nan) if self.stable is None
                           else np.asarray(self.stable, dtype=float))
         cols["energy_error"] = self.energy_error
@@ -556,9 +562,12 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
     if error_estimate and Xs.shape[0]:
         outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings)
+    stuck = stuck_contacts(problem, Xs, np.array(pts_w))
+    if stuck is not None:
+        settings["stuck_points"] = int(np.count_nonzero(stuck))
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
-                     jumps, eouts, Ys)
+                     jumps, eouts, Ys, stuck)
 
 
 def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
@@ -582,6 +591,12 @@ def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
         worst[name] = {"error": float(E[k, i]), "freq_hz": float(ws[k] / (2 * np.pi))}
     info["max"] = worst
     settings["error_estimate"] = info
+    H = int(problem.basis.harmonics.max())
+    top = max((v["error"] for v in worst.values()), default=0.0)
+    if H >= 5 and top < SMALL_ERROR:
+        settings["harmonics_note"] = (
+            f"estimated errors stay below {SMALL_ERROR:g} at every point: H = {H} is more than this response "
+            f"needs (the Newton systems grow as H^2 and their factorisations as H^3); try harmonics = {max(3, H // 2)}")
     bad = {n: v for n, v in worst.items() if v["error"] > WARN_ERROR}
     if bad:
         n, v = max(bad.items(), key=lambda kv: kv[1]["error"])

@@ -29,6 +29,7 @@ from .fourier import FourierBasis
 
 MAX_UNKNOWNS = 2000
 WARN_ERROR = 1e-2        # a point estimated worse than this is named in a warning
+SMALL_ERROR = 1e-7       # every point better than this: the harmonics are more than needed
 
 
 def richer_basis(basis: FourierBasis) -> FourierBasis:

@@ -20,7 +20,7 @@ def test_frf_writes_csv_png_summary(tmp_path):
     assert r.returncode == 0, r.stderr
     with open(out / "frf.csv") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0] == ["freq_hz", "x_h1", "x_max", "x_err", "stable"]
+    assert rows[0] == ["freq_hz", "x_h1", "x_max", "x_err", "stuck_contacts", "stable"]
     assert len(rows) > 20
     f = [float(r[0]) for r in rows[1:]]
     assert f[0] == pytest.approx(20.0) and f[-1] == pytest.approx(50.0)

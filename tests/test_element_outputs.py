@@ -186,7 +186,7 @@ def test_frf_element_outputs_and_csv_columns(tmp_path):
     write_frf(case, res, tmp_path)
     with open(tmp_path / "frf.csv") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0] == ["freq_hz", "x_h1", "x_max", "x_err", "slip", "work", "f", "stable"]
+    assert rows[0] == ["freq_hz", "x_h1", "x_max", "x_err", "slip", "work", "f", "stuck_contacts", "stable"]
     col = rows[0].index("slip")
     np.testing.assert_allclose([float(r[col]) for r in rows[1:]], slip, rtol=1e-9)
 
@@ -197,4 +197,4 @@ def test_frf_without_element_outputs_keeps_the_contract(tmp_path):
     assert res.element_outputs == {}
     write_frf(case, res, tmp_path)
     with open(tmp_path / "frf.csv") as fh:
-        assert next(csv.reader(fh)) == ["freq_hz", "x_h1", "x_max", "x_err", "stable"]
+        assert next(csv.reader(fh)) == ["freq_hz", "x_h1", "x_max", "x_err", "stuck_contacts", "stable"]

@@ -35,7 +35,7 @@ def test_cli_runs_the_rig_as_documented(tmp_path):
     with open(out / "frf.csv") as fh:
         header = next(csv.reader(fh))
     assert header == ["freq_hz", "tip1_h1", "tip1_max", "tip1_err", "tip2_h1", "tip2_max", "tip2_err",
-                      "damper_y_h1", "damper_y_max", "damper_y_err", "stable"]
+                      "damper_y_h1", "damper_y_max", "damper_y_err", "stuck_contacts", "stable"]
     frf = read_frf(out / "frf.csv")
     assert frf["freq_hz"][0] == pytest.approx(290.0) and frf["freq_hz"][-1] == pytest.approx(380.0)
     # one continuation crosses both modes; at CF/Fexc = 1e4 the damper is stuck, so the peaks

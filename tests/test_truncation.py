@@ -69,3 +69,12 @@ def test_richer_basis_keeps_the_pattern():
     assert list(odd.harmonics) == [1, 3, 5, 7, 9, 11] and odd.n_samples >= 128
     full = richer_basis(FourierBasis([0, 1, 2, 3], 16))
     assert list(full.harmonics) == list(range(8))
+
+
+def test_harmonics_beyond_need_are_noted():
+    raw = hbm.load_case(ROOT / "rigs" / "sdof_jenkins.toml").raw
+    raw["element"][0]["slip_force"] = 1e6                       # stuck: a linear response
+    res = hbm.frf(hbm.case_from_dict(raw), harmonics=9, stability=False)
+    assert "H = 9 is more than this response needs" in res.settings["harmonics_note"]
+    res = hbm.frf(hbm.load_case(ROOT / "rigs" / "sdof_jenkins.toml"), stability=False)
+    assert "harmonics_note" not in res.settings
