@@ -125,6 +125,8 @@ class Arclength:
     overwrite_jacobian : bool
         ``fun`` returns a new ``J`` on every call, which the solver may scale in place (saves
         one ``n x (n+1)`` array per evaluation on large systems).
+    describe_lam : callable, optional
+        ``lam -> str`` naming a parameter value in messages (default ``"lam=<value>"``).
 
     Attributes
     ----------
@@ -147,7 +149,7 @@ class Arclength:
 
     def __init__(self, fun: Fun, x0, scale=None, lam_bounds=(-np.inf, np.inf),
                  direction: int = +1, options: ArclengthOptions | None = None, lam_step=None,
-                 overwrite_jacobian: bool = False):
+                 overwrite_jacobian: bool = False, describe_lam=None):
         x0 = np.array(x0, dtype=float).ravel()
         if x0.size < 2 or not np.all(np.isfinite(x0)):
             raise ValueError("x0 must be a finite vector [y, lam] with at least one unknown")
@@ -171,6 +173,8 @@ class Arclength:
         self.options = options if options is not None else ArclengthOptions()
         self.lam_step = lam_step
         self._overwrite = bool(overwrite_jacobian)
+        # how messages name a parameter value (e.g. in Hz for a caller whose lam is rad/s)
+        self._lam = describe_lam or (lambda lam: f"lam={lam:.6g}")
         self.ds0, self.ds_min, self.ds_max = self.options.step_lengths((hi - lo) / scale[-1])
         self.status = "running"
         self.message = ""
@@ -241,7 +245,7 @@ class Arclength:
         c = self._fixed_lam(xs, xs[-1])
         self._rho0 = c.ev.row_norm() or 1.0
         if not c.converged:
-            self._fail(f"starting point not solved at lam={self.x0[-1]:.6g}: {c.reason}")
+            self._fail(f"starting point not solved at {self._lam(self.x0[-1])}: {c.reason}")
             return
         e = np.zeros_like(xs)
         e[-1] = self.direction
@@ -260,11 +264,11 @@ class Arclength:
             if steps >= o.max_steps:
                 self.status = "max_steps"
                 self.message = (f"stopped after max_steps={o.max_steps} steps at "
-                                f"lam={xs[-1] * s_lam:.6g}")
+                                f"{self._lam(xs[-1] * s_lam)}")
                 return
             if (xs[-1] >= hi_s and t[-1] > 0) or (xs[-1] <= lo_s and t[-1] < 0):
                 self.status = "finished"
-                self.message = f"parameter reached the bound lam={xs[-1] * s_lam:.6g}"
+                self.message = f"parameter reached the bound {self._lam(xs[-1] * s_lam)}"
                 return
 
             ds = self._limited(xs, t, ds)
@@ -286,7 +290,7 @@ class Arclength:
                 ds *= 0.5
                 if ds < self.ds_min:
                     self._fail(f"step size fell below ds_min={self.ds_min:.3g} at "
-                               f"lam={xs[-1] * s_lam:.6g} after {consecutive} rejections: "
+                               f"{self._lam(xs[-1] * s_lam)} after {consecutive} rejections: "
                                f"{reason}")
                     return
                 continue
@@ -305,7 +309,7 @@ class Arclength:
             if on_bound:
                 self.status = "finished"
                 self.message = (f"parameter left the bounds; last point solved on "
-                                f"lam={c.xs[-1] * s_lam:.6g} after {steps} steps, "
+                                f"{self._lam(c.xs[-1] * s_lam)} after {steps} steps, "
                                 f"{len(self.folds)} folds, {self.n_rejected} rejections")
                 return
             xs = c.xs

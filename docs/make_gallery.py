@@ -22,6 +22,15 @@ def _about(case: pathlib.Path) -> str:
     return " ".join(x for x in lines if x)
 
 
+def _worst_estimate(settings) -> str:
+    """``, estimated truncation error up to ... at ... Hz`` from the settings, or empty."""
+    est = (settings.get("error_estimate") or {}).get("max") or {}
+    if not est:
+        return ""
+    name, v = max(est.items(), key=lambda kv: kv[1]["error"])
+    return f", estimated error of {name}_h1 up to {v['error']:.1e} (at {v['freq_hz']:.5g} Hz)"
+
+
 def main() -> None:
     out = ["# Gallery", "",
            "Every shipped rig (`hbm rigs`) as `hbm frf rigs/<rig>.toml` draws it, with its summary.",
@@ -43,7 +52,8 @@ def main() -> None:
         out += [f"## `{case.stem}`: {s['case']}", "", _about(case), ""] + figure + [
                 f"{s['n_points']} points, H = {st['harmonics'][-1]}, N = {st['time_samples']}, "
                 f"{st.get('solver', '?')} solver, status {s['status']}"
-                + (f", largest energy-balance error {err:.1e}." if err is not None else ".")
+                + (f", largest energy-balance error {err:.1e}" if err is not None else "")
+                + _worst_estimate(st) + "."
                 + (f" Document: `rigs/{doc.name}`." if doc.exists() else ""), ""]
         if s["status"] != "finished":
             out += [f"**`hbm frf` stops on this rig with its defaults:** {s['message']}", ""]

@@ -24,6 +24,7 @@ from .energy import energy_balance
 from .fourier import FourierBasis, max_abs
 from .jumps import predict_jumps
 from .newton import newton
+from .peak_refine import refine_peaks
 from .problem_setup import (_first_point, _residual_scale, _stuck_damping, _stuck_stiffness,  # noqa: F401
                             _unknown_scale, build_problem, choose_solver, output_amplitudes,
                             recover_outputs, resolve_settings, setting_sources, solve_at)
@@ -108,7 +109,8 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     """
     scale = np.r_[xscale, bounds[1] - bounds[0]]
     solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
-                       direction=direction, options=opts, lam_step=lam_step, overwrite_jacobian=True)
+                       direction=direction, options=opts, lam_step=lam_step, overwrite_jacobian=True,
+                       describe_lam=lambda lam: f"{lam / (2 * np.pi):.6g} Hz")
     polish_solve = ReusedLU() if problem.n_unknowns >= REUSE_MIN_SIZE else None
     for pt in solver:
         X = problem.expand(pt.x[:-1])
@@ -217,6 +219,11 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         if len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
             status = "max_steps"
             message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[-1] / (2 * np.pi):.6g} Hz"
+    if len(pts.w) >= 3 and 1 in basis.harmonics:
+        rc = basis.row_of(1, "c")
+        settings["peak_points_added"] = refine_peaks(
+            problem, pts, segments, lambda X, w: recover_outputs(problem, case, X, w),
+            lambda Y: np.hypot(Y[rc], Y[rc + 1]), xscale, r_scale)
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
     _closure_warning(settings, pts.unclosed, pts.w)
