@@ -136,6 +136,57 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     return solver.status, solver.message, [f / (2 * np.pi) for f in solver.folds], solver.n_rejected
 
 
+GAP_FIRST = 1e-3        # first restart this share of the window past a stop, doubled per try
+GAP_TRIES = 8
+MAX_GAPS = 10
+
+
+def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, opts, progress, lam_step,
+                        outcome, settings):
+    """Where the continuation stopped inside the window, solve a fresh point a little further
+    (``GAP_FIRST`` of the window, doubled up to ``GAP_TRIES`` times) and trace on from it.
+
+    A stop at a stick-slip discontinuity (static above kinetic friction) or a corner the
+    corrector cannot turn leaves the rest of the window untraced; restarting past it gives the
+    user the rest, and every skipped stretch is stated: ``settings["gaps"]`` (from, to, why)
+    and a ``gap_warning``.  Returns the last segment's ``(status, message, folds, n_rejected)``.
+    """
+    status, message, folds, n_rej = outcome
+    w_lo, w_hi = window
+    gaps = []
+    while (status == "failed" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9) and len(gaps) < MAX_GAPS
+           and len(pts.w) < case.analysis.max_points):
+        w_from, restart = pts.w[-1], None
+        for k in range(GAP_TRIES):
+            w_r = min(w_from + GAP_FIRST * 2 ** k * (w_hi - w_lo), w_hi)
+            try:
+                Xr, itr = _first_point(problem, case, w_r, xscale, r_scale)
+            except RuntimeError:
+                if w_r == w_hi:
+                    break
+                continue
+            if energy_balance(problem, Xr, w_r).relative_error <= ENERGY_LIMIT:
+                restart = (Xr, itr, w_r)
+                break
+            if w_r == w_hi:
+                break
+        if restart is None:
+            message += "; no restart past it converged"
+            break
+        gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": restart[2] / (2 * np.pi), "reason": message})
+        start = len(pts.w)
+        status, message, f2, r2 = _trace(problem, case, pts, restart[0], restart[1], restart[2], (w_lo, w_hi), +1,
+                                         xscale, r_scale, opts, progress, offset=0, lam_step=lam_step)
+        folds, n_rej = folds + f2, n_rej + r2
+        segments.append([start, len(pts.w)])
+    if gaps:
+        settings["gaps"] = gaps
+        where = ", ".join(f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz" for g in gaps)
+        settings["gap_warning"] = (f"the continuation stopped {len(gaps)} time(s) and was restarted further on; "
+                                   f"not traced: {where} (first stop: {gaps[0]['reason']})")
+    return status, message, folds, n_rej
+
+
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
         progress=None, options: ArclengthOptions | None = None, stability: bool = True,
         stability_options: StabilityOptions | None = None, error_estimate: bool = True) -> FRFResult:
@@ -195,6 +246,9 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
                      lam_step=lam_step)
         status, message, folds, n_rej = seg
         segments.append([0, len(pts.w)])
+        status, message, folds, n_rej = _restart_past_stops(
+            problem, case, pts, segments, (w_lo, w_hi), xscale, r_scale, opts, progress, lam_step,
+            (status, message, folds, n_rej), settings)
         if status == "finished" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9):
             # the branch folded back out of the window at fmin (e.g. a softening upper branch):
             # the rest of the window lies on another branch, traced from fmax downwards

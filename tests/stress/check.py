@@ -82,7 +82,7 @@ def assess(data: dict, **frf_kwargs) -> dict:
     Returns
     -------
     dict
-        ``name``, ``verdict`` (``converged`` / ``failed`` / ``bad``), ``detail`` (one line),
+        ``name``, ``verdict`` (``converged`` / ``gaps`` (finished past stated stops) / ``failed`` / ``bad``), ``detail`` (one line),
         ``points``, ``max_energy_error``, ``seconds``, ``stuck_checked`` (bool).
     """
     case = case_from_dict(data)
@@ -139,6 +139,8 @@ def assess(data: dict, **frf_kwargs) -> dict:
                     problems.append(f"stuck peak |X1| = {top:.4g} missed: the path's largest is {X1.max():.4g}")
     if problems:
         return {**rec, "verdict": "bad", "detail": "; ".join(problems) + f" [status {res.status}: {res.message}]"}
+    if res.ok and res.settings.get("gaps"):
+        return {**rec, "verdict": "gaps", "detail": res.settings["gap_warning"]}
     if res.ok:
         return {**rec, "verdict": "converged", "detail": ""}
     if not res.message:
