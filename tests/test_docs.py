@@ -38,7 +38,8 @@ def test_undocumented_element_key_stops_the_reference(monkeypatch):
         schema.reference()
 
 
-@pytest.mark.parametrize("doc", ["README.md", "docs/README.md", "docs/api.md", "docs/gallery.md"])
+@pytest.mark.parametrize("doc", ["README.md", "docs/README.md", "docs/api.md", "docs/gallery.md"]
+                         + [str(p.relative_to(ROOT)) for p in sorted((ROOT / "docs" / "gallery").glob("*.md"))])
 def test_links_stay_inside_the_repository(doc):
     text = (ROOT / doc).read_text()
     assert "../shared" not in text and "DESIGN.md" not in text
@@ -48,3 +49,11 @@ def test_links_stay_inside_the_repository(doc):
             assert (base / target).exists(), f"{doc} links to missing {target}"
     for path in re.findall(r"`((?:docs|rigs)/[\w./-]+\.(?:md|toml|png))`", text):
         assert (ROOT / path).exists() or "<" in path, f"{doc} names missing {path}"
+
+
+def test_gallery_has_a_page_per_rig():
+    rigs = sorted(p.stem for p in (ROOT / "rigs").glob("*.toml"))
+    pages = sorted(p.stem for p in (DOCS / "gallery").glob("*.md"))
+    assert pages == rigs
+    index = (DOCS / "gallery.md").read_text()
+    assert all(f"(gallery/{r}.md)" in index for r in rigs)
