@@ -21,13 +21,15 @@ import numpy as np
 JUMP_COLOURS = {"up": "tab:red", "down": "tab:blue"}
 
 
-def _runs(stable: np.ndarray) -> list:
+def _runs(stable: np.ndarray, starts=()) -> list:
     """Index ranges ``(a, b, is_stable)`` of equal stability, each sharing its first point
-    with the previous range so that the drawn curve has no gaps."""
+    with the previous range so that the drawn curve has no gaps, except at ``starts``: path
+    indices where a segment restarted past a stop begins (nothing was traced before it)."""
     out, a = [], 0
+    starts = set(int(i) for i in starts)
     for i in range(1, stable.size + 1):
-        if i == stable.size or stable[i] != stable[a]:
-            out.append((max(a - 1, 0), i - 1, bool(stable[a])))
+        if i == stable.size or stable[i] != stable[a] or i in starts:
+            out.append((a if a in starts or a == 0 else max(a - 1, 0), i - 1, bool(stable[a])))
             a = i
     return out
 
@@ -62,6 +64,10 @@ def _draw_errors(ax, freq, errs, colours):
                     label=name)
     ax.axhline(0.01, color="tab:red", lw=0.8, ls="--", label="1 %")
     ax.set_ylim(bottom=max(1e-8, ax.get_ylim()[0]))
+    if all(np.nanmax(np.nan_to_num(e, nan=0.0), initial=0.0) < 1e-8 for e in errs.values()):
+        ax.set_ylim(1e-8, 1e-1)
+        ax.text(0.5, 0.5, "below 1e-8 at every point", transform=ax.transAxes, ha="center", va="center",
+                fontsize=8, color="0.4")
     ax.set_ylabel("estimated error")
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=7, ncol=3)
@@ -93,7 +99,8 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
                              squeeze=False, gridspec_kw={"height_ratios": [ratios[p] for p in panels]})
     ax = axes[0, 0]
     stable = np.ones(res.freq_hz.size, dtype=bool) if res.stable is None else np.asarray(res.stable)
-    runs = _runs(stable)
+    gap_starts = [seg[0] for seg in res.settings.get("segments", [])[1:]] if res.settings.get("gaps") else []
+    runs = _runs(stable, gap_starts)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, (name, o) in enumerate(res.outputs.items()):
         _draw_output(ax, res.freq_hz, o.h1 / scale, o.max / scale, runs, colours[k % len(colours)], name,
