@@ -14,12 +14,13 @@ DOCS = ROOT / "docs"
 
 
 def _about(case: pathlib.Path) -> str:
-    """The case file's opening comment, as one paragraph."""
+    """The case file's comments before its first table, as one paragraph."""
     lines = []
     for line in case.read_text().splitlines():
-        if not line.startswith("#"):
+        if line.startswith("["):
             break
-        lines.append(line.lstrip("# ").rstrip())
+        if line.startswith("#"):
+            lines.append(line.lstrip("# ").rstrip())
     return " ".join(x for x in lines if x)
 
 

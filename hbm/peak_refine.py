@@ -102,6 +102,8 @@ def refine_peaks(problem, pts, segments, outputs_of, amplitudes, xscale, r_scale
                 if not res.converged:
                     continue
                 X = problem.expand(res.x)
+                if np.linalg.norm(X - pts.X[i]) > np.linalg.norm(pts.X[i + 1] - pts.X[i - 1]):
+                    continue                          # landed on another branch
                 Y = outputs_of(X, ws)
                 h1 = amplitudes(Y)[o]
                 if h1 < max(a[i - 1], a[i + 1]) or abs(h1 - a[i]) <= AMPLITUDE_TOL * a[i]:

@@ -24,6 +24,7 @@ from .energy import energy_balance
 from .fourier import FourierBasis, max_abs
 from .jumps import predict_jumps
 from .newton import newton
+from .curve_fill import fill_long_steps
 from .peak_refine import refine_peaks
 from .problem_setup import (_first_point, _residual_scale, _stuck_damping, _stuck_stiffness,  # noqa: F401
                             _unknown_scale, build_problem, choose_solver, output_amplitudes,
@@ -273,6 +274,9 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         if len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
             status = "max_steps"
             message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[-1] / (2 * np.pi):.6g} Hz"
+    if len(pts.w) >= 2:
+        settings["fill_points_added"] = fill_long_steps(
+            problem, pts, segments, lambda X, w: recover_outputs(problem, case, X, w), (w_lo, w_hi), xscale, r_scale)
     if len(pts.w) >= 3 and 1 in basis.harmonics:
         rc = basis.row_of(1, "c")
         settings["peak_points_added"] = refine_peaks(
