@@ -75,6 +75,8 @@ def build_parser():
     f.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     f.add_argument("--no-stability", dest="stability", action="store_false",
                    help="skip the Hill stability of the points (empty 'stable' column)")
+    f.add_argument("--tol", type=_positive_float,
+                   help="raise the harmonics until every point's estimated error of the first harmonic is below TOL")
     _add_analysis_options(f)
     t = sub.add_parser("timesim", help="time-domain reference at one frequency (steady state or transient)")
     t.add_argument("case", help="case file (TOML)")
@@ -138,8 +140,13 @@ def cmd_frf(args) -> int:
         compile_notice()
         bar = FRFProgress(args.fmin or case.analysis.freq_hz[0], args.fmax or case.analysis.freq_hz[1])
     try:
-        res = frf(case, harmonics=args.harmonics, samples=args.samples, fmin=args.fmin, fmax=args.fmax,
-                  transform=args.transform, progress=bar, stability=args.stability)
+        kw = dict(samples=args.samples, fmin=args.fmin, fmax=args.fmax, transform=args.transform,
+                  progress=bar, stability=args.stability)
+        if args.tol is not None:
+            from .adaptive import frf_to_tolerance
+            res = frf_to_tolerance(case, args.tol, harmonics=args.harmonics, **kw)
+        else:
+            res = frf(case, harmonics=args.harmonics, **kw)
     finally:
         if bar is not None:
             bar.close()
@@ -148,6 +155,10 @@ def cmd_frf(args) -> int:
           f"{summary['solve_seconds']:.3f} s, H={res.settings['harmonics'][-1]}, N={res.settings['time_samples']}"
           + _defaults_note(res.settings))
     st = res.settings
+    if st.get("adaptive"):
+        a = st["adaptive"]
+        steps = " -> ".join(f"H={t['H']} (largest estimate {t['max_error']:.1e}, {t['seconds']:.2f} s)" for t in a["tried"])
+        print(f"  harmonics for --tol {a['tol']:g}: {steps}" + ("" if a["met"] else ": tolerance NOT met"))
     if st.get("solver") == "condensed":
         print(f"  condensed solver: {st['n_dof']} DOFs -> {st['contact_coordinates']} contact coordinates, "
               f"{st['modes']} modes (to {st['highest_kept_mode_hz']:.6g} Hz), reduction {st['reduction_seconds']:.3f} s"

@@ -40,6 +40,10 @@ class FRFProgress:
         self.bar = _bar(100.0, "%", "FRF", "{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}{postfix}]")
 
     def __call__(self, n: int, freq_hz) -> None:
+        if n <= 1 and freq_hz is not None:       # a new trace (e.g. with more harmonics for --tol)
+            self.bar.reset(total=100.0)
+            self.bar.set_description("FRF")
+            self.done = 0.0
         if freq_hz is None:
             self.bar.set_description("stability (Hill)")
             self.bar.refresh()
