@@ -85,8 +85,9 @@ class Excitation:
             object.__setattr__(self, "force_sine", np.zeros_like(self.force))
 
     @property
-    def has_sine(self) -> bool:
-        return bool(np.any(self.force_sine))
+    def cos_sin(self) -> np.ndarray:
+        """Rows ``[force, force_sine]``, shape (2, n): the solvers' and the time stepper's input."""
+        return np.vstack([self.force, self.force_sine])
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,30 @@ MAX_SHARE = 1.0 / 60.0
 BRANCH_SHARE = 0.5      # a solved point farther than this share of the step from its guess is refused
 
 
+def solve_near(problem, guess, w, radius, xscale, r_scale, tol=1e-10):
+    """Newton at fixed ``w`` from ``guess`` (n_coef, n): ``(X, iterations)``, or None when it
+    fails or lands farther than ``radius`` from the guess (another branch coexisting at ``w``)."""
+    fun = lambda u: problem.residual(problem.expand(u), w)[:2]
+    res = newton(fun, problem.unknowns(guess), scale=xscale, r_scale=r_scale, tol=tol)
+    if not res.converged:
+        return None
+    X = problem.expand(res.x)
+    return (X, res.iterations) if np.linalg.norm(X - guess) <= radius else None
+
+
+def insert_point(problem, pts, segments, k, at, X, w, its, Y) -> None:
+    """Insert the solved point ``(X, w)`` with outputs ``Y`` at path index ``at`` of segment
+    ``k`` (its energy error and loop closure taken here); later segments shift by one."""
+    err = energy_balance(problem, X, w).relative_error
+    for name, v in (("X", X), ("w", w), ("Y", Y), ("its", its), ("err", err),
+                    ("unclosed", problem.nl.last_unclosed)):
+        getattr(pts, name).insert(at, v)
+    segments[k][1] += 1
+    for seg in segments[k + 1:]:
+        seg[0] += 1
+        seg[1] += 1
+
+
 def fill_long_steps(problem, pts, segments, outputs_of, window, xscale, r_scale) -> int:
     """Insert points so that no step inside a segment spans more than ``MAX_SHARE`` of the
     window (module doc); returns how many were inserted.
@@ -53,29 +77,16 @@ def fill_long_steps(problem, pts, segments, outputs_of, window, xscale, r_scale)
                 i += 1
                 continue
             X0, X1 = pts.X[i], pts.X[i + 1]
+            radius = BRANCH_SHARE * np.linalg.norm(X1 - X0)
             new = []
             for j in range(1, n_new + 1):
                 t = j / (n_new + 1)
                 w = w0 + t * (w1 - w0)
-                guess = (1 - t) * X0 + t * X1
-                fun = lambda u, w=w: problem.residual(problem.expand(u), w)[:2]
-                res = newton(fun, problem.unknowns(guess), scale=xscale, r_scale=r_scale)
-                if res.converged:
-                    X = problem.expand(res.x)
-                    # on this branch, not on another one that coexists at w (between folds)
-                    if np.linalg.norm(X - guess) <= BRANCH_SHARE * np.linalg.norm(X1 - X0):
-                        new.append((X, w, res.iterations))
+                got = solve_near(problem, (1 - t) * X0 + t * X1, w, radius, xscale, r_scale)
+                if got is not None:
+                    new.append((got[0], w, got[1]))
             for off, (X, w, its) in enumerate(new, start=1):
-                at = i + off
-                values = {"X": X, "w": w, "Y": outputs_of(X, w), "its": its,
-                          "err": energy_balance(problem, X, w).relative_error,
-                          "unclosed": problem.nl.last_unclosed}
-                for name, v in values.items():
-                    getattr(pts, name).insert(at, v)
-            segments[k][1] += len(new)
-            for seg in segments[k + 1:]:
-                seg[0] += len(new)
-                seg[1] += len(new)
+                insert_point(problem, pts, segments, k, i + off, X, w, its, outputs_of(X, w))
             added += len(new)
             i += len(new) + 1
     return added

@@ -29,7 +29,7 @@ def _runs(stable: np.ndarray, starts=()) -> list:
     starts = set(int(i) for i in starts)
     for i in range(1, stable.size + 1):
         if i == stable.size or stable[i] != stable[a] or i in starts:
-            out.append((a if a in starts or a == 0 else max(a - 1, 0), i - 1, bool(stable[a])))
+            out.append((a if a in starts else max(a - 1, 0), i - 1, bool(stable[a])))
             a = i
     return out
 

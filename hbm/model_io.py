@@ -42,6 +42,8 @@ import numpy as np
 import scipy.io
 import scipy.sparse as sp
 
+from elements.base import MAGNITUDE_MAX
+
 
 @dataclass(frozen=True)
 class ModelData:
@@ -105,8 +107,8 @@ def _real(A, name, path):
         raise ValueError(f"{path}: {name} holds {A.dtype} values, not numbers")
     A = A.astype(float) if sp.issparse(A) else np.asarray(A, dtype=float)
     data = A.data if sp.issparse(A) else A
-    if np.any(np.abs(data[np.isfinite(data)]) > 1e100):
-        raise ValueError(f"{path}: {name} has entries above 1e+100 in magnitude (products would overflow)")
+    if np.any(np.abs(data[np.isfinite(data)]) > MAGNITUDE_MAX):
+        raise ValueError(f"{path}: {name} has entries above {MAGNITUDE_MAX:g} in magnitude (products would overflow)")
     return A
 
 

@@ -4,13 +4,14 @@ The continuation's steps are sized for the corrector, so a smooth peak usually f
 two points and the drawn curve (and the reported peak) is low by up to a few tenths of a per
 cent.  For every resonance peak of every output (a local maximum of prominence at least 10 % of
 its height along a stretch where the frequency is monotone) the parabola through the peak
-point :math:`i` and its neighbours,
+point :math:`i` and its neighbours, in Newton form
 
 .. math::
 
-    a(w) \approx a_i + \frac{(w - w_i)\,\big[(w - w_{i-1}) s_+ - (w - w_{i+1}) s_-\big]}{w_{i+1} - w_{i-1}},
+    a(w) = a_{i-1} + d_1 (w - w_{i-1}) + c\,(w - w_{i-1})(w - w_i),
 
-with :math:`s_\pm` the one-sided slopes, has its vertex at :math:`w^*`; the balance is solved
+with :math:`d_1` the first and :math:`c < 0` the second divided difference, has its vertex at
+:math:`w^* = (w_{i-1} + w_i)/2 - d_1 / (2c)`; the balance is solved
 there by Newton at fixed frequency from :math:`X_i` and the point is inserted in path order.
 This repeats (at most ``ROUNDS`` times per peak) until the vertex moves the amplitude by less
 than ``AMPLITUDE_TOL``.  A solve that fails, or lands off the branch (amplitude below both
@@ -20,8 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .energy import energy_balance
-from .newton import newton
+from .curve_fill import insert_point, solve_near
 
 ROUNDS = 3
 AMPLITUDE_TOL = 1e-5
@@ -41,11 +41,17 @@ def _vertex(w3, a3):
     return 0.5 * (w0 + w1) - d1 / (2 * c)
 
 
+def prominent_maxima(a, prominence: float = PROMINENCE) -> np.ndarray:
+    """Indices of the local maxima of ``a`` (n,) whose prominence
+    (:func:`scipy.signal.find_peaks`) is at least ``prominence`` times their own height."""
+    from scipy.signal import find_peaks
+    a = np.asarray(a, dtype=float)
+    return find_peaks(a, prominence=(prominence * np.abs(a), None))[0]
+
+
 def _peak_indices(w, a):
     """Interior resonance peaks of ``a`` along the path where ``w`` is monotone around them."""
-    from scipy.signal import find_peaks
-    idx, _ = find_peaks(a, prominence=(PROMINENCE * np.abs(a), None))
-    return [int(i) for i in idx if 0 < i < len(a) - 1 and (w[i] - w[i - 1]) * (w[i + 1] - w[i]) > 0]
+    return [int(i) for i in prominent_maxima(a) if 0 < i < len(a) - 1 and (w[i] - w[i - 1]) * (w[i + 1] - w[i]) > 0]
 
 
 def _segment_of(segments, i):
@@ -53,16 +59,6 @@ def _segment_of(segments, i):
         if s <= i - 1 and i + 1 < e:
             return k
     return None
-
-
-def _insert(pts, segments, k, at, values) -> None:
-    """Insert one point at path index ``at`` into segment ``k``; later segments shift."""
-    for name, v in values.items():
-        getattr(pts, name).insert(at, v)
-    segments[k][1] += 1
-    for seg in segments[k + 1:]:
-        seg[0] += 1
-        seg[1] += 1
 
 
 def refine_peaks(problem, pts, segments, outputs_of, amplitudes, xscale, r_scale) -> int:
@@ -97,21 +93,17 @@ def refine_peaks(problem, pts, segments, outputs_of, amplitudes, xscale, r_scale
                 ws = _vertex(w[i - 1:i + 2], a[i - 1:i + 2])
                 if k is None or ws is None or not min(w[i - 1], w[i + 1]) < ws < max(w[i - 1], w[i + 1]):
                     continue
-                fun = lambda u, ws=ws: problem.residual(problem.expand(u), ws)[:2]
-                res = newton(fun, problem.unknowns(pts.X[i]), scale=xscale, r_scale=r_scale, tol=1e-12)
-                if not res.converged:
+                got = solve_near(problem, pts.X[i], ws, np.linalg.norm(pts.X[i + 1] - pts.X[i - 1]),
+                                 xscale, r_scale, tol=1e-12)
+                if got is None:
                     continue
-                X = problem.expand(res.x)
-                if np.linalg.norm(X - pts.X[i]) > np.linalg.norm(pts.X[i + 1] - pts.X[i - 1]):
-                    continue                          # landed on another branch
+                X, its = got
                 Y = outputs_of(X, ws)
                 h1 = amplitudes(Y)[o]
                 if h1 < max(a[i - 1], a[i + 1]) or abs(h1 - a[i]) <= AMPLITUDE_TOL * a[i]:
                     continue
-                at = i if (ws - w[i]) * (w[i + 1] - w[i]) < 0 else i + 1
-                err = energy_balance(problem, X, ws).relative_error
-                _insert(pts, segments, k, at, {"X": X, "w": ws, "Y": Y, "its": res.iterations, "err": err,
-                                               "unclosed": problem.nl.last_unclosed})
+                insert_point(problem, pts, segments, k, i if (ws - w[i]) * (w[i + 1] - w[i]) < 0 else i + 1,
+                             X, ws, its, Y)
                 added += 1
                 moved = True
             if not moved:

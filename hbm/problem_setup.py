@@ -111,8 +111,7 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
     st = case.structure
     info = {"solver": solver, "n_dof": st.n_dof}
     if solver == "full":
-        ex = case.excitation
-        problem = HarmonicBalance(case.model, case.elements, basis, np.vstack([ex.force, ex.force_sine]), tr,
+        problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.cos_sin, tr,
                                   base=case.excitation.base, output_rows=case.analysis.output_rows(st.n_dof))
         info.update(modes=None, reduction_seconds=0.0)
     elif case.excitation.base is not None:
@@ -120,7 +119,7 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
                         f"set [model] solver = \"full\"")
     else:
         G_o = case.analysis.output_rows(st.n_dof)
-        force = np.vstack([case.excitation.force, case.excitation.force_sine])
+        force = case.excitation.cos_sin
         rows = np.vstack([e.gather for e in case.elements] + [force, G_o])
         keep = np.flatnonzero(np.any(rows != 0.0, axis=0))
         modes = case.reduction.modes or st.default_modes()

@@ -20,18 +20,15 @@ import numpy as np
 
 from .frf_plot import write_plot
 from .jumps import predict_jumps
-from .sweep_summary import excitation_scale
+from .peak_refine import prominent_maxima
+from .sweep_summary import excitation_scale, receptance_unit
 
 
-PEAK_PROMINENCE = 0.1
-
-
-def peaks(freq: np.ndarray, amp: np.ndarray, prominence: float = PEAK_PROMINENCE) -> list:
+def peaks(freq: np.ndarray, amp: np.ndarray) -> list:
     """Resonance peaks of ``amp`` along the path: ``[{"freq_hz": f, "amplitude": a}, ...]``.
 
-    A peak is a local maximum whose prominence (:func:`scipy.signal.find_peaks`: its height
-    above the higher of the two lowest points that separate it from higher ground) is at
-    least ``prominence`` times its own height, so that ripples of a stick-slip transition or
+    A peak is a local maximum whose prominence is at least 10 % of its own height
+    (:func:`hbm.peak_refine.prominent_maxima`), so that ripples of a stick-slip transition or
     a fold are not reported as resonances.  When none qualifies (a window that holds only a
     flank), the largest amplitude is reported.
 
@@ -39,14 +36,11 @@ def peaks(freq: np.ndarray, amp: np.ndarray, prominence: float = PEAK_PROMINENCE
     ----------
     freq, amp : ndarray, shape (n,)
         Frequencies (Hz) and amplitudes along the path.
-    prominence : float
-        Least prominence relative to the peak's height.
     """
-    from scipy.signal import find_peaks
     amp = np.asarray(amp, dtype=float)
     if not amp.size:
         return []
-    idx, _ = find_peaks(amp, prominence=(prominence * np.abs(amp), None))
+    idx = prominent_maxima(amp)
     if not idx.size:
         idx = np.array([int(np.argmax(amp))])
     return [{"freq_hz": float(freq[i]), "amplitude": float(amp[i])} for i in idx]
@@ -134,6 +128,6 @@ def write_frf(case, res, outdir, extra=None) -> dict:
     with open(out / "summary.json", "w") as fh:
         json.dump(summary, fh, indent=2)
     if res.freq_hz.size:
-        unit = "m/m" if case.excitation.base is not None and not np.any(case.excitation.force) else "m/N"
-        write_plot(res, out / "frf.png", case.name, excitation_scale(case), unit, summary["jumps"])
+        write_plot(res, out / "frf.png", case.name, excitation_scale(case), receptance_unit(case),
+                   summary["jumps"])
     return summary

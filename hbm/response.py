@@ -274,14 +274,15 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         if len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
             status = "max_steps"
             message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[-1] / (2 * np.pi):.6g} Hz"
+    def outputs_of(X, w):
+        return recover_outputs(problem, case, X, w)
     if len(pts.w) >= 2:
-        settings["fill_points_added"] = fill_long_steps(
-            problem, pts, segments, lambda X, w: recover_outputs(problem, case, X, w), (w_lo, w_hi), xscale, r_scale)
+        settings["fill_points_added"] = fill_long_steps(problem, pts, segments, outputs_of, (w_lo, w_hi),
+                                                        xscale, r_scale)
     if len(pts.w) >= 3 and 1 in basis.harmonics:
         rc = basis.row_of(1, "c")
-        settings["peak_points_added"] = refine_peaks(
-            problem, pts, segments, lambda X, w: recover_outputs(problem, case, X, w),
-            lambda Y: np.hypot(Y[rc], Y[rc + 1]), xscale, r_scale)
+        settings["peak_points_added"] = refine_peaks(problem, pts, segments, outputs_of,
+                                                     lambda Y: np.hypot(Y[rc], Y[rc + 1]), xscale, r_scale)
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
     _closure_warning(settings, pts.unclosed, pts.w)
@@ -341,14 +342,15 @@ def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
     above ``WARN_ERROR``, a ``truncation_warning``."""
     t0 = time.perf_counter()
     rb = richer_basis(problem.basis)
-    rp, _ = build_problem(case, rb, "auto", fmax_hz)
-    E = truncation_errors(problem, rp, Xs, ws)
-    info = {"computed": E is not None, "richer_harmonics": int(rb.harmonics.max()),
-            "seconds": round(time.perf_counter() - t0, 6)}
-    if E is None:
-        info["reason"] = f"the richer problem has {rp.n_unknowns} unknowns (> {MAX_UNKNOWNS})"
+    info = {"computed": False, "richer_harmonics": int(rb.harmonics.max())}
+    n_richer = rb.n_coef * problem.n_unknowns // problem.basis.n_coef
+    if n_richer > MAX_UNKNOWNS:      # decided before the richer problem is built
+        info["reason"] = f"the richer problem would have {n_richer} unknowns (> {MAX_UNKNOWNS})"
         settings["error_estimate"] = info
         return outputs
+    rp, _ = build_problem(case, rb, "auto", fmax_hz)
+    E = truncation_errors(problem, rp, Xs, ws)
+    info.update(computed=True, seconds=round(time.perf_counter() - t0, 6))
     out, worst = {}, {}
     for i, (name, o) in enumerate(outputs.items()):
         out[name] = OutputSeries(o.h1, o.max, E[:, i])

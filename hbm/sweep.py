@@ -42,7 +42,7 @@ from .atomic import FolderLock, write_atomic
 from .casekeys import find_ratio_key, get_key, scale_excitation, set_key
 from .sweep_plot import write_plot
 from .sweep_values import parse_assignment, parse_values, value_label
-from .sweep_summary import excitation_scale, optimum, run_peaks, write_summary_csv
+from .sweep_summary import excitation_scale, optimum, receptance_unit, run_peaks, write_summary_csv
 
 __all__ = ["FORCE_RATIO", "FRFOverrides", "SweepOptions", "SweepResult", "sweep", "optimum",
            "parse_values", "parse_assignment", "make_tasks", "run_task"]
@@ -366,7 +366,7 @@ def _sweep_into(tasks, key, out, ratio_key, options, progress) -> SweepResult:
             log = all(v > 0 for v in vals) and (options.log_axis or max(vals) >= 100 * min(vals))
             label = (f"force ratio {ratio_key or find_ratio_key(tasks[0].raw)} / F" if key == FORCE_RATIO
                      else key)
-            base = case_from_dict(tasks[0].raw, tasks[0].path, Path(tasks[0].base_dir)).excitation.base
+            first = case_from_dict(tasks[0].raw, tasks[0].path, Path(tasks[0].base_dir))
             write_plot(out / "sweep.png", rows, outputs, label, log,
-                       {t.index: out / "runs" / t.name for t in tasks}, "m/m" if base is not None else "m/N")
+                       {t.index: out / "runs" / t.name for t in tasks}, receptance_unit(first))
     return SweepResult(key, rows, out)

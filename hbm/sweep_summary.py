@@ -40,6 +40,12 @@ def excitation_scale(case) -> float:
     return f
 
 
+def receptance_unit(case) -> str:
+    """``"m/N"`` under a force, ``"m/m"`` (a transmissibility) under support motion alone."""
+    ex = case.excitation
+    return "m/m" if ex.base is not None and not np.any(np.hypot(ex.force, ex.force_sine)) else "m/N"
+
+
 def run_peaks(res, force: float) -> dict:
     """Per output: ``amplitude``, ``freq_hz``, ``max`` and ``receptance`` of the path's peak.
 

@@ -767,7 +767,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     M = np.ascontiguousarray(case.model.M, dtype=float)
     C = np.ascontiguousarray(case.model.C, dtype=float)
     K = np.ascontiguousarray(case.model.K, dtype=float)
-    F2 = np.ascontiguousarray(np.vstack([case.excitation.force, case.excitation.force_sine]), dtype=float)
+    F2 = np.ascontiguousarray(case.excitation.cos_sin, dtype=float)
     rows = N + 1 if check else periods * N + 1
     need = 8.0 * rows * (n + 3 * n_f) + 8.0 * 4 * n * n
     if need > MEMORY_SHARE * machine_memory():

@@ -17,9 +17,8 @@ relative error of each output's first harmonic is
 
     e = \frac{\big|\, |y_1(X + \delta)| - |y_1(X)| \,\big|}{|y_1(X + \delta)|}.
 
-It costs one residual, Jacobian and LU of the richer problem per point, so it is computed
-when that problem has at most ``MAX_UNKNOWNS`` unknowns (``None`` otherwise, and the FRF's
-settings say so).
+It costs one residual, Jacobian and LU of the richer problem per point, so the FRF computes
+it when that problem has at most ``MAX_UNKNOWNS`` unknowns (its settings say so otherwise).
 """
 from __future__ import annotations
 
@@ -62,7 +61,7 @@ def _h1(basis: FourierBasis, Y: np.ndarray) -> np.ndarray:
     return np.hypot(Y[r], Y[r + 1])
 
 
-def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray | None:
+def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
     """Estimated relative error of every output's first harmonic at every point.
 
     Parameters
@@ -75,11 +74,10 @@ def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray | None:
 
     Returns
     -------
-    ndarray, shape (n_points, n_outputs), or None when the richer problem is too large.
+    ndarray, shape (n_points, n_outputs)
+        NaN where the richer Jacobian is singular.
     """
     rp = richer_problem
-    if rp.n_unknowns > MAX_UNKNOWNS:
-        return None
     out = np.full((len(ws), rp.output_rows.shape[0]), np.nan)
     for k, (X, w) in enumerate(zip(Xs, ws)):
         Xr = embed(X, problem.basis, rp.basis)

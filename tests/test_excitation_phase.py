@@ -91,7 +91,7 @@ def test_condensed_solver_agrees_with_the_full_one(strategy):
     basis = FourierBasis(full.analysis.harmonics, full.analysis.time_samples)
     ref, _ = build_problem(cond, basis, "auto")
     ex = cond.excitation
-    p = CondensedHarmonicBalance(ref.reduced, cond.elements, basis, np.vstack([ex.force, ex.force_sine]),
+    p = CondensedHarmonicBalance(ref.reduced, cond.elements, basis, ex.cos_sin,
                                  ref.nl.transform, ref.output_rows, linear_strategy=strategy)
     assert p._builder.strategy == strategy and p.F_e.shape[1] == 2
     Xf, _, pf = solve_at(full, 36.0)

@@ -5,8 +5,6 @@ fresh point past it."""
 import pathlib
 import sys
 
-import numpy as np
-
 import hbm
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
