@@ -115,6 +115,17 @@ class Element:
         spec = self.law_spec()
         return None if spec is None else [(np.arange(self.n_local), spec)]
 
+    def time_parts(self):
+        """``[(R, LawSpec), ...]``: the laws the time integrator steps, part ``p`` reading
+        ``R_p z`` (``R_p`` of shape (n_part, n_local)) of the local coordinates ``z``; the
+        element force is ``sum_p R_p^T f_p``.  By default the rows of :meth:`law_parts`; None
+        if the element has no time-step law."""
+        parts = self.law_parts()
+        if parts is None:
+            return None
+        eye = np.eye(self.n_local)
+        return [(eye[np.asarray(rows, dtype=int)], spec) for rows, spec in parts]
+
     @property
     def n_start(self) -> int:
         """Columns of ``u`` the start rule looks at (all local coordinates by default)."""

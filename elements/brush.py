@@ -59,7 +59,7 @@ import math
 
 import numpy as np
 
-from .base import (Element, coordinate_rows, require_keys, positive, non_negative, finite,
+from .base import (Element, LawSpec, coordinate_rows, require_keys, positive, non_negative, finite,
                    principal_reversal)
 from .hertz import hertz_contact
 
@@ -242,6 +242,25 @@ class Brush(Element):
 
     def law_spec(self):
         return None     # one kernel over all bristles (march_counts), not a single law
+
+    def time_parts(self):
+        """One friction3d part per distinct bristle: it reads ``[u_t, c_b . z]`` of the
+        contact-centre coordinates ``T z``, so ``R_b = [I_nt 0; c_b] T``; a bristle standing
+        for ``w_b`` identical ones has ``w_b kt``, ``w_b kn`` and ``w_b p_b`` (the law is
+        homogeneous of degree one in them), the same forces as the harmonic march."""
+        from .friction3d import Friction3D
+        from .kinds import FRICTION3D
+        nt, nl = self.n_tangential, self.n_local
+        parts = []
+        for c, w, p in zip(self._coef, self._weight, self._pre):
+            R = np.zeros((nt + 1, nl))
+            R[:nt, :nt] = np.eye(nt)
+            R[nt] = c
+            params = np.array([w * self.kt, w * self.kn, self.mu, w * p, nt], dtype=float)
+            spec = LawSpec(FRICTION3D, params, 2 * nt + 1, Friction3D.closure, Friction3D.start_rule,
+                           nt + 1, self.max_passes, self.closure_tol, False)
+            parts.append((R @ self._T, spec))
+        return parts
 
     def march(self, z, dz):
         f, df, _ = self.march_counts(z, dz)

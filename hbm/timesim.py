@@ -72,396 +72,17 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-import numba as nb
 import numpy as np
-
-from elements.kernels import law_step, law_init
 
 from .budget import MEMORY_SHARE, machine_memory
 from .case import Case, CaseError
+from .time_kernels import element_forces, init_states
+from .time_march import march
+from .time_parts import Packed, pack_elements
 
 
-# --------------------------------------------------------------------------------------
-# numba kernels
-# --------------------------------------------------------------------------------------
-
-@nb.njit(cache=True)
-def _n_input(nl, velocity):
-    return 2 * nl if velocity != 0 else nl
-
-
-@nb.njit(cache=True)
-def _gather(g_all, row, x):
-    s = 0.0
-    for k in range(x.size):
-        g = g_all[row, k]
-        if g != 0.0:
-            s += g * x[k]
-    return s
-
-
-@nb.njit(cache=True)
-def _init_states(kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off, q, v, S, D, Dref):
-    """Rest states at coordinates ``G q`` (velocities ``G v``) and their tangents ``D``."""
-    for e in range(kinds.size):
-        g0 = g_off[e]
-        nl = g_off[e + 1] - g0
-        ns = s_off[e + 1] - s_off[e]
-        nin = _n_input(nl, vel[e])
-        z = np.zeros(nin)
-        for i in range(nl):
-            z[i] = _gather(g_all, g0 + i, q)
-            if vel[e] != 0:
-                z[nl + i] = _gather(g_all, g0 + i, v)
-        C0 = np.zeros((ns, nin))
-        law_init(kinds[e], p_all[p_off[e]:p_off[e + 1]], z, S[s_off[e]:s_off[e + 1]], C0)
-        m = 0.0
-        for i in range(nl):
-            for j in range(nin):
-                D[d_off[e] + i * nin + j] = C0[i, j]
-                m = max(m, abs(C0[i, j]))
-        Dref[e] = m
-
-
-@nb.njit(cache=True)
-def _element_forces(S, s_off, g_all, g_off, q, fnl):
-    """``fnl = sum_e G_e^T f_e`` from the states ``S``."""
-    fnl[:] = 0.0
-    for e in range(g_off.size - 1):
-        g0 = g_off[e]
-        for i in range(g_off[e + 1] - g0):
-            fi = S[s_off[e] + i]
-            for k in range(q.size):
-                g = g_all[g0 + i, k]
-                if g != 0.0:
-                    fnl[k] += g * fi
-
-
-@nb.njit(cache=True)
-def _eval_elements(q, v, c1, kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
-                   S, S_trial, D_trial, fnl, Kt, z, Abuf, Bbuf, Keff):
-    """Trial states from the committed ``S`` at ``(q, v)``: forces ``fnl``, tangent ``Kt``."""
-    n = q.size
-    fnl[:] = 0.0
-    Kt[:, :] = 0.0
-    for e in range(kinds.size):
-        g0 = g_off[e]
-        nl = g_off[e + 1] - g0
-        s0 = s_off[e]
-        ns = s_off[e + 1] - s0
-        nin = _n_input(nl, vel[e])
-        for i in range(nl):
-            z[i] = _gather(g_all, g0 + i, q)
-            if vel[e] != 0:
-                z[nl + i] = _gather(g_all, g0 + i, v)
-        A = Abuf[:ns, :ns]
-        B = Bbuf[:ns, :nin]
-        law_step(kinds[e], p_all[p_off[e]:p_off[e + 1]], S[s0:s0 + ns], z[:nin],
-                 S_trial[s0:s0 + ns], A, B)
-        d0 = d_off[e]
-        for i in range(nl):
-            for j in range(nin):
-                D_trial[d0 + i * nin + j] = B[i, j]
-            for j in range(nl):
-                Keff[i, j] = B[i, j]
-                if vel[e] != 0:
-                    Keff[i, j] += c1 * B[i, nl + j]
-        for i in range(nl):
-            fi = S_trial[s0 + i]
-            for k in range(n):
-                g = g_all[g0 + i, k]
-                if g == 0.0:
-                    continue
-                fnl[k] += g * fi
-                for j in range(nl):
-                    kij = g * Keff[i, j]
-                    if kij == 0.0:
-                        continue
-                    for m in range(n):
-                        g2 = g_all[g0 + j, m]
-                        if g2 != 0.0:
-                            Kt[k, m] += kij * g2
-
-
-@nb.njit(cache=True)
-def _max_abs(x):
-    m = 0.0
-    for i in range(x.size):
-        a = abs(x[i])
-        if a > m:
-            m = a
-    return m
-
-
-@nb.njit(cache=True)
-def _step(M, C, K, F0, F1, h, alpha, newton_tol, max_iter,
-          q0, v0, a0, f0, q1, v1, a1, f1,
-          kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
-          S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp,
-          fixed, ybase, w, th1):
-    """One HHT/Newmark step of size ``h`` by Newton; returns iterations, or -1 on failure.
-
-    ``q1`` enters as the predictor and leaves as the solution; ``S_trial``/``D_trial`` hold the
-    element states/tangents at the solution (not committed here).  ``Jinv`` caches the inverse
-    iteration matrix for the step size ``h_c[0]`` and element tangent ``Kt_c``.
-
-    Support DOFs (``fixed[i] != 0``) take the prescribed motion ``ybase[i] cos(th1)`` with its
-    exact velocity and acceleration at the step's end; their rows of the residual are dropped
-    (identity rows and columns in the iteration matrix), so only the free DOFs are unknowns.
-    """
-    n = q0.size
-    cth = np.cos(th1)
-    sth = np.sin(th1)
-    for i in range(n):
-        if fixed[i] != 0:
-            q1[i] = ybase[i] * cth
-    gamma = 0.5 - alpha
-    beta = 0.25 * (1.0 - alpha) ** 2
-    c0 = 1.0 / (beta * h * h)
-    c1 = gamma / (beta * h)
-    ca = 1.0 / (2.0 * beta) - 1.0
-    mrow = 0.0
-    for i in range(n):
-        if fixed[i] != 0:       # a support's own row is not solved: its mass plays no part
-            continue
-        r = 0.0
-        for j in range(n):
-            r += abs(M[i, j])
-        mrow = max(mrow, r)
-    # old-time part of the residual: -alpha (C v0 + K q0 + f0) + alpha F0 - (1 + alpha) F1
-    for i in range(n):
-        old = f0[i]
-        for j in range(n):
-            old += C[i, j] * v0[j] + K[i, j] * q0[j]
-        tmp[i] = -alpha * old + alpha * F0[i] - (1.0 + alpha) * F1[i]
-    for it in range(max_iter + 1):
-        for i in range(n):
-            if fixed[i] != 0:
-                a1[i] = -w * w * ybase[i] * cth
-                v1[i] = -w * ybase[i] * sth
-            else:
-                a1[i] = c0 * (q1[i] - q0[i] - h * v0[i]) - ca * a0[i]
-                v1[i] = v0[i] + h * ((1.0 - gamma) * a0[i] + gamma * a1[i])
-        _eval_elements(q1, v1, c1, kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
-                       S, S_trial, D_trial, f1, Kt, z, Abuf, Bbuf, Keff)
-        rnorm = 0.0
-        big_i = 0.0
-        big_r = 0.0
-        for i in range(n):
-            inert = 0.0
-            restore = f1[i]
-            for j in range(n):
-                inert += M[i, j] * a1[j]
-                restore += C[i, j] * v1[j] + K[i, j] * q1[j]
-            R[i] = inert + (1.0 + alpha) * restore + tmp[i]
-            if fixed[i] != 0:
-                R[i] = 0.0
-                continue
-            rnorm = max(rnorm, abs(R[i]))
-            big_i = max(big_i, abs(inert))
-            big_r = max(big_r, abs(restore))
-        if not math.isfinite(rnorm):
-            return -1
-        # relative to the largest force term, including c0 |M| |q|: the inertia term is a
-        # difference of displacements times c0 = 1/(beta h^2), so its round-off grows as h^-2
-        # (the test then bounds the displacement error by about newton_tol |q|)
-        scale = big_i + big_r + _max_abs(F1) + c0 * mrow * _max_abs(q1) + 1e-300
-        if rnorm <= newton_tol * scale:
-            return it
-        if it == max_iter:
-            return -1
-        same = h == h_c[0]
-        if same:
-            for i in range(n):
-                for j in range(n):
-                    if Kt[i, j] != Kt_c[i, j]:
-                        same = False
-                        break
-                if not same:
-                    break
-        if not same:
-            J = c0 * M + (1.0 + alpha) * (c1 * C + K + Kt)
-            for i in range(n):
-                if fixed[i] != 0:
-                    J[i, :] = 0.0
-                    J[:, i] = 0.0
-                    J[i, i] = 1.0
-            Jinv[:, :] = np.linalg.inv(J)
-            Kt_c[:, :] = Kt
-            h_c[0] = h
-        for i in range(n):
-            dq = 0.0
-            for j in range(n):
-                dq += Jinv[i, j] * R[j]
-            q1[i] -= dq
-    return -1
-
-
-@nb.njit(cache=True)
-def _record(row, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v):
-    rec_q[row, :] = q
-    c = 0
-    for e in range(g_off.size - 1):
-        for i in range(g_off[e + 1] - g_off[e]):
-            rec_f[row, c] = S[s_off[e] + i]
-            rec_u[row, c] = _gather(g_all, g_off[e] + i, q)
-            rec_v[row, c] = _gather(g_all, g_off[e] + i, v)
-            c += 1
-
-
-@nb.njit(cache=True)
-def _march(M, C, K, F2, w, t_off, N, k0, n_periods, check, tol, have_prev,
-           q, v, a, fnl, S, D, Dref,
-           kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
-           alpha, newton_tol, max_iter, max_level, jump_tol,
-           rec_mode, rec_q, rec_f, rec_u, rec_v, prev, cur, stats, fixed, ybase):
-    """Integrate ``n_periods`` whole periods of ``N`` steps from global step ``k0``.
-
-    The state ``q, v, a, fnl, S, D, Dref`` is updated in place.  ``rec_mode`` 0 records the
-    current period in rows ``0..N`` (overwritten every period); 1 records row ``k`` for global
-    step ``k``.  With ``check``, stops as soon as a period repeats the previous one to ``tol``.
-
-    Returns
-    -------
-    status : int
-        1 periodic (converged), 0 all periods done, -1 Newton failed at the finest sub-step.
-    periods : int
-        Periods completed in this call.
-    change : float
-        Relative change of the last completed period against the one before (-1 if none).
-    t_fail : float
-        Time of the failed step (status -1), else 0.
-    """
-    n = q.size
-    T = 2.0 * np.pi / w
-    dt = T / N
-    unit = 1 << max_level
-    n_el = kinds.size
-    ns_max = 1
-    nin_max = 1
-    for e in range(n_el):
-        ns_max = max(ns_max, s_off[e + 1] - s_off[e])
-        nin_max = max(nin_max, _n_input(g_off[e + 1] - g_off[e], vel[e]))
-    Abuf = np.zeros((ns_max, ns_max))
-    Bbuf = np.zeros((ns_max, nin_max))
-    Keff = np.zeros((nin_max, nin_max))
-    z = np.zeros(nin_max)
-    S_trial = S.copy()
-    D_trial = D.copy()
-    Kt = np.zeros((n, n))
-    Kt_c = np.full((n, n), np.nan)
-    Jinv = np.zeros((n, n))
-    h_c = np.array([np.nan])
-    R = np.zeros(n)
-    tmp = np.zeros(n)
-    q1 = np.zeros(n)
-    v1 = np.zeros(n)
-    a1 = np.zeros(n)
-    f1 = np.zeros(n)
-    F0 = np.zeros(n)
-    F1 = np.zeros(n)
-    change = -1.0
-    k = k0
-    for pp in range(n_periods):
-        if rec_mode == 0:
-            _record(0, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
-        elif k < rec_q.shape[0]:
-            _record(k, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
-        for j in range(1, N + 1):
-            # one output step from global index k to k + 1, in dyadic sub-steps
-            pos = 0
-            lev = 0
-            kk = k % N
-            while pos < unit:
-                size = unit >> lev
-                h = dt / (1 << lev)
-                t0 = (k * unit + pos) * (dt / unit)
-                t1 = (k * unit + pos + size) * (dt / unit)
-                th0 = 2.0 * np.pi * (kk * unit + pos) / (N * unit)
-                th1 = 2.0 * np.pi * (kk * unit + pos + size) / (N * unit)
-                on0 = 1.0 if t0 <= t_off else 0.0
-                on1 = 1.0 if t1 <= t_off else 0.0
-                cs0, sn0, cs1, sn1 = np.cos(th0), np.sin(th0), np.cos(th1), np.sin(th1)
-                for i in range(n):   # the load Fc cos + Fs sin at both ends of the step
-                    F0[i] = on0 * (cs0 * F2[0, i] + sn0 * F2[1, i])
-                    F1[i] = on1 * (cs1 * F2[0, i] + sn1 * F2[1, i])
-                for i in range(n):   # predictor: constant acceleration
-                    q1[i] = q[i] + h * v[i] + 0.5 * h * h * a[i]
-                its = _step(M, C, K, F0, F1, h, alpha, newton_tol, max_iter,
-                            q, v, a, fnl, q1, v1, a1, f1,
-                            kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off,
-                            S, S_trial, D_trial, Kt, z, Abuf, Bbuf, Keff, R, Jinv, Kt_c, h_c, tmp,
-                            fixed, ybase, w, th1)
-                if its < 0:
-                    stats[3] += 1
-                    if lev >= max_level:
-                        return -1, pp, change, t0
-                    lev += 1
-                    continue
-                stats[0] += its
-                # status change of an element inside the step: refine to locate it
-                jumped = False
-                for e in range(n_el):
-                    nl = g_off[e + 1] - g_off[e]
-                    m = nl * _n_input(nl, vel[e])
-                    d0 = d_off[e]
-                    jump = 0.0
-                    big = Dref[e]
-                    for r in range(m):
-                        jump = max(jump, abs(D_trial[d0 + r] - D[d0 + r]))
-                        big = max(big, abs(D_trial[d0 + r]))
-                    if big > 0.0 and jump > jump_tol * big:
-                        jumped = True
-                if jumped and lev < max_level:
-                    stats[2] += 1
-                    lev += 1
-                    continue
-                # commit
-                stats[1] += 1
-                for i in range(n):
-                    q[i] = q1[i]
-                    v[i] = v1[i]
-                    a[i] = a1[i]
-                    fnl[i] = f1[i]
-                S[:] = S_trial
-                D[:] = D_trial
-                for e in range(n_el):
-                    nl = g_off[e + 1] - g_off[e]
-                    m = nl * _n_input(nl, vel[e])
-                    for r in range(m):
-                        Dref[e] = max(Dref[e], abs(D[d_off[e] + r]))
-                pos += size
-                while lev > 0 and pos % (size << 1) == 0:
-                    lev -= 1
-                    size <<= 1
-            k += 1
-            if check:
-                cur[j - 1, :] = q
-            if rec_mode == 0:
-                _record(j, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
-            elif k < rec_q.shape[0]:
-                _record(k, q, v, S, s_off, g_all, g_off, rec_q, rec_f, rec_u, rec_v)
-        if check:
-            diff = 0.0
-            scale = 0.0
-            for j in range(N):
-                for i in range(n):
-                    diff = max(diff, abs(cur[j, i] - prev[j, i]))
-                    scale = max(scale, abs(cur[j, i]))
-            prev[:, :] = cur
-            if have_prev:
-                change = diff / scale if scale > 0.0 else 0.0
-                if change <= tol:
-                    return 1, pp + 1, change, 0.0
-            have_prev = True
-    return 0, n_periods, change, 0.0
-
-
-# --------------------------------------------------------------------------------------
-# Python layer
-# --------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
 class TimeSimOptions:
@@ -594,69 +215,6 @@ class TimeSimResult:
         return self.fine.history
 
 
-@dataclass
-class _Packed:
-    kinds: np.ndarray
-    p_all: np.ndarray
-    p_off: np.ndarray
-    s_off: np.ndarray
-    g_all: np.ndarray
-    g_off: np.ndarray
-    vel: np.ndarray
-    d_off: np.ndarray
-    names: tuple = field(default=())
-
-    def args(self):
-        return (self.kinds, self.p_all, self.p_off, self.s_off, self.g_all, self.g_off,
-                self.vel, self.d_off)
-
-
-def _time_parts(element):
-    """``[(gather rows (n_part, n_dof), LawSpec, force names), ...]``: the laws the element
-    steps through in time (its :meth:`law_parts`: a wedge's flank contacts, one law for a
-    plain element)."""
-    parts = element.law_parts()
-    if not parts:
-        raise CaseError(f"element {element.name}: {type(element).__name__} has no time-step law; "
-                        f"the time-domain reference does not support it")
-    names = tuple(element.coord_names) if len(element.coord_names) == element.n_local else \
-        tuple(str(i) for i in range(element.n_local))
-    out = []
-    for rows, spec in parts:
-        rows = np.asarray(rows, dtype=np.int64)
-        if element.n_local == 1:
-            labels = (f"{element.name}_f",)
-        else:
-            labels = tuple(f"{element.name}_f_{names[r]}" for r in rows)
-        out.append((element.gather[rows], spec, labels))
-    return out
-
-
-def pack_elements(elements, n_dof: int) -> _Packed:
-    """Flat arrays of the elements' law parts for the kernel (kinds, params/states/gathers
-    with offsets, one entry per part: :func:`_time_parts`)."""
-    parts = [p for e in elements for p in _time_parts(e)]
-    n_el = len(parts)
-    kinds = np.array([spec.kind for _, spec, _ in parts], dtype=np.int64)
-    p_off = np.zeros(n_el + 1, dtype=np.int64)
-    s_off = np.zeros(n_el + 1, dtype=np.int64)
-    g_off = np.zeros(n_el + 1, dtype=np.int64)
-    d_off = np.zeros(n_el + 1, dtype=np.int64)
-    names = []
-    for i, (G, spec, labels) in enumerate(parts):
-        n_local = G.shape[0]
-        p_off[i + 1] = p_off[i] + spec.params.size
-        s_off[i + 1] = s_off[i] + spec.n_state
-        g_off[i + 1] = g_off[i] + n_local
-        d_off[i + 1] = d_off[i] + n_local * n_local * (2 if spec.velocity else 1)
-        names += labels
-    p_all = np.concatenate([spec.params for _, spec, _ in parts]) if n_el else np.zeros(0)
-    g_all = np.vstack([G for G, _, _ in parts]) if n_el else np.zeros((0, n_dof))
-    vel = np.array([1 if spec.velocity else 0 for _, spec, _ in parts], dtype=np.int64)
-    return _Packed(kinds, np.ascontiguousarray(p_all, dtype=float), p_off, s_off,
-                   np.ascontiguousarray(g_all, dtype=float), g_off, vel, d_off, tuple(names))
-
-
 def _support(case: Case):
     """``fixed`` (n,) int64 flags of the support DOFs and ``ybase`` (n,) their amplitudes."""
     n = case.n_dof
@@ -679,7 +237,7 @@ class _State:
     run does not begin with a jolt.
     """
 
-    def __init__(self, case: Case, packed: _Packed, F: np.ndarray, w: float = 0.0):
+    def __init__(self, case: Case, packed: Packed, F: np.ndarray, w: float = 0.0):
         n = case.n_dof
         K = case.model.K
         fixed, ybase = _support(case)
@@ -692,25 +250,29 @@ class _State:
             Ks = K + sum((e.gather.T @ e.linear_stiffness() @ e.gather for e in case.elements),
                          np.zeros_like(K))
             self.q[fr] = -np.linalg.lstsq(Ks[np.ix_(fr, fr)], Ks[np.ix_(fr, fx)] @ ybase[fx], rcond=None)[0]
-        self.S = np.zeros(int(packed.s_off[-1]))
-        self.D = np.zeros(int(packed.d_off[-1]))
-        self.Dref = np.zeros(packed.kinds.size)
-        _init_states(*packed.args(), self.q, self.v, self.S, self.D, self.Dref)
+        self.S = np.zeros(packed.n_states)
+        self.D = np.zeros(packed.n_tangents)
+        self.Dref = np.zeros(packed.n_parts)
+        init_states(packed.laws, self.q, self.v, self.S, self.D, self.Dref)
         self.fnl = np.zeros(n)
         self.a = np.zeros(n)
         self.rebalance(case, packed, F, w)
 
-    def rebalance(self, case: Case, packed: _Packed, F: np.ndarray, w: float) -> None:
+    def rebalance(self, case: Case, packed: Packed, F: np.ndarray, w: float) -> None:
         """Element forces from the states and the acceleration that balances the equations
         at phase 0 (load ``F``), for the present ``q``, ``v``, ``S``."""
         M, C, K = case.model.M, case.model.C, case.model.K
         fixed, ybase = _support(case)
         fx = np.flatnonzero(fixed)
         fr = np.flatnonzero(fixed == 0)
-        _element_forces(self.S, packed.s_off, packed.g_all, packed.g_off, self.q, self.fnl)
+        element_forces(packed.laws, self.S, self.fnl)
         self.a[fx] = -w * w * ybase[fx]
         rhs = F - C @ self.v - K @ self.q - self.fnl - M[:, fx] @ self.a[fx]
         self.a[fr] = np.linalg.solve(M[np.ix_(fr, fr)], rhs[fr])
+
+    def arrays(self) -> tuple:
+        """``(q, v, a, fnl, S, D, Dref)``, the kernels' state tuple (updated in place)."""
+        return self.q, self.v, self.a, self.fnl, self.S, self.D, self.Dref
 
     def copy(self):
         other = object.__new__(_State)
@@ -763,7 +325,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     N = int(steps)
     n = case.n_dof
     packed = pack_elements(case.elements, n)
-    n_f = int(packed.g_off[-1])
+    n_f = packed.g_out.shape[0]
     M = np.ascontiguousarray(case.model.M, dtype=float)
     C = np.ascontiguousarray(case.model.C, dtype=float)
     K = np.ascontiguousarray(case.model.K, dtype=float)
@@ -778,6 +340,10 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     rec_u = np.zeros((rows, n_f))
     rec_v = np.zeros((rows, n_f))
     fixed, ybase = _support(case)
+    model = (M, C, K, F2, fixed, ybase)
+    laws_opts = (float(opts.alpha), float(opts.newton_tol), int(opts.max_iter), int(opts.max_level),
+                 float(opts.jump_tol))
+    rec = (0 if check else 1, rec_q, rec_f, rec_u, rec_v) + packed.record_map()
     prev = np.zeros((N if check else 1, n))
     cur = np.zeros_like(prev)
     stats = np.zeros(4, dtype=np.int64)
@@ -788,12 +354,9 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     while done < periods:
         chunk = min(chunk, periods - done)
         tc = time.perf_counter()
-        status, pp, ch, t_fail = _march(
-            M, C, K, F2, w, t_off, N, done * N, chunk, check, opts.tol, done > 0,
-            state.q, state.v, state.a, state.fnl, state.S, state.D, state.Dref,
-            *packed.args(), float(opts.alpha), float(opts.newton_tol), int(opts.max_iter),
-            int(opts.max_level), float(opts.jump_tol),
-            0 if check else 1, rec_q, rec_f, rec_u, rec_v, prev, cur, stats, fixed, ybase)
+        run = (w, t_off, N, done * N, chunk, bool(check), float(opts.tol), done > 0)
+        status, pp, ch, t_fail = march(model, packed.laws, laws_opts, run, state.arrays(), rec,
+                                       prev, cur, stats)
         done += pp
         if ch >= 0:
             change = ch

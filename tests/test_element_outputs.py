@@ -1,7 +1,6 @@
 """Element outputs in ``[analysis] outputs`` ("ELEMENT.QUANTITY"), the element summaries,
 weighted coordinates ([[dof, coefficient], ...]) and the frf.csv columns."""
 import csv
-import copy
 
 import numpy as np
 import pytest

@@ -1,7 +1,6 @@
 """Hill's problem on every harmonic and with the modes above the harmonics static
 (hbm.stability.HillSystem, hbm.modal_hill): the two causes of spurious instabilities found
 on the shipped cases, each against a reference that does not depend on them."""
-import copy
 import tomllib
 from pathlib import Path
 

@@ -1,7 +1,6 @@
 """Newton's linear solves: GMRES on a kept LU (continuation.linsolve) against direct LU, and a
 whole FRF traced with the kept LU against the direct path."""
 import numpy as np
-import pytest
 
 import continuation.arclength as arclength
 from continuation.linsolve import ReusedLU, direct_solve

@@ -9,7 +9,6 @@ from pathlib import Path
 import numba
 import numpy as np
 import pytest
-import scipy.linalg as sla
 
 import hbm
 from hbm.cli import main

@@ -16,9 +16,9 @@ and its own approach, linear in the element coordinates ``z``:
 
     u_{n,b} = c_b \cdot z \qquad (c_b = [0_{nt}, 1, y_b, -x_b] \text{ for } [u_t, u_n, \theta_1, \theta_2]),
 
-so ``N_b = max(p_b + k_n u_{n,b}, 0)``.  friction3d returns ``N_b - p_b`` along the normal;
-the bristle's dynamic normal force about rest is ``N_b - max(p_b, 0)``, which differs by the
-constant ``min(p_b, 0)``.  The element forces are the resultants
+so ``N_b = max(p_b + k_n u_{n,b}, 0)``; friction3d returns the bristle's dynamic normal force
+about rest, ``N_b - max(p_b, 0)`` (zero at rest whether the bristle is loaded or clear at
+rest).  The element forces are the resultants
 
 .. math::
 
@@ -121,7 +121,7 @@ def brush_march(kt, kn, mu, nt, pre, weight, coef, z, dz, start, max_passes, tol
             else:
                 closed_all = False
         rest = -p if p > 0.0 else 0.0          # -max(p, 0)
-        off = p if p < 0.0 else 0.0            # min(p, 0)
+        off = p if p < 0.0 else 0.0            # min(p, 0): N_b - max(p, 0) = kn u_n + off
         if open_all:
             counts[0] += int(w)
             for c in range(nt, nl):
@@ -159,7 +159,7 @@ def brush_march(kt, kn, mu, nt, pre, weight, coef, z, dz, start, max_passes, tol
                 f[j, a] += w * fb[j, a]
                 for q in range(P):
                     df[j, a, q] += w * dfb[j, a, q]
-            fn = fb[j, nt] + off
+            fn = fb[j, nt]
             for c in range(nt, nl):
                 wc = w * coef[b, c]
                 if wc != 0.0:

@@ -7,10 +7,12 @@ Normal law (no memory), ``u_n > 0`` closes the contact:
 
 .. math::
 
-    N = \max(N_0 + k_n u_n, 0), \qquad f_n = N - N_0
+    N = \max(N_0 + k_n u_n, 0), \qquad f_n = N - \max(N_0, 0)
 
 so the element force is zero at rest and ``-N0`` while the contact is open (the static load
 that creates ``N0`` is balanced elsewhere: forces are dynamic forces about equilibrium).
+``N0 < 0`` is a gap of ``-N0 / kn`` at rest (a brush bristle clear of the indenter): the
+contact is open at rest and ``f_n = N``, again zero at rest.
 
 Tangential law: an incremental return mapping with a circular slip limit ``mu N``:
 
@@ -97,9 +99,9 @@ def _normal_and_slider(p, z, s_new, B):
     if Nload <= 0.0:
         for a in range(nt):
             s_new[a] = 0.0
-        s_new[nt] = -N0
+        s_new[nt] = -N0 if N0 > 0.0 else 0.0            # -max(N0, 0)
     else:
-        s_new[nt] = kn * z[nt]
+        s_new[nt] = kn * z[nt] + (N0 if N0 < 0.0 else 0.0)   # N - max(N0, 0)
         B[nt, nt] = kn
     return Nload
 
