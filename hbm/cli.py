@@ -88,6 +88,10 @@ def build_parser():
     t.add_argument("--periods", type=_positive_int, help="transient mode: integrate this many periods from rest")
     t.add_argument("--switch-off-at", type=float, help="transient mode: force off after this time, s")
     t.add_argument("--alpha", type=float, help="HHT alpha in [-1/3, 0] (default 0: Newmark average acceleration)")
+    t.add_argument("--shoot-after", type=_positive_int,
+                   help="plain periods before the steady state is sought by shooting (default 200)")
+    t.add_argument("--floquet", action="store_true",
+                   help="also compute the Floquet multipliers of the steady state (stability)")
     t.add_argument("-q", "--quiet", action="store_true", help="no progress output")
 
     s = sub.add_parser("sweep", help="one FRF per value of a case key (or of the force ratio)")
@@ -210,7 +214,11 @@ def cmd_timesim(args) -> int:
         if not (math.isfinite(args.switch_off_at) and args.switch_off_at >= 0):
             raise CaseError(f"--switch-off-at must be a time >= 0 s, got {args.switch_off_at:g}")
     over = {k: v for k, v in (("steps", args.steps), ("tol", args.tol), ("max_periods", args.max_periods),
-                               ("alpha", args.alpha)) if v is not None}
+                               ("alpha", args.alpha), ("shoot_after", args.shoot_after)) if v is not None}
+    if args.floquet:
+        if args.periods is not None:
+            raise CaseError("--floquet needs the steady-state mode (no --periods)")
+        over["floquet"] = True
     opts = dataclasses.replace(TimeSimOptions(), **over)
     opts.validate()
     from .progress import CountProgress, compile_notice
@@ -246,6 +254,12 @@ def cmd_timesim(args) -> int:
     for name in case.analysis.outputs:
         print(f"  {name}: h1 {res.h1[name]:.6g}  max {res.max[name]:.6g}")
     print(f"  error estimate {res.error_estimate:.2e} (relative change n={n} -> 2n={2 * n} steps per period)")
+    for run in (res.coarse, res.fine):
+        if run.shooting is not None:
+            print(f"  {run.steps} steps: {run.shooting.message}")
+    if res.floquet is not None:
+        verdict = "stable" if res.floquet[0] else "UNSTABLE"
+        print(f"  Floquet: largest |multiplier| {res.floquet[1]:.6f}: {verdict}")
     print(f"  wrote {args.out}/timesim.csv, history.csv, timesim.png")
     if not res.converged:
         sys.stderr.write(f"hbm: timesim: no periodic steady state within {opts.max_periods} periods "

@@ -19,6 +19,7 @@ import numba as nb
 import numpy as np
 
 from .time_kernels import _n_input, step
+from .time_sensitivity import propagate
 
 
 @nb.njit(cache=True)
@@ -84,7 +85,7 @@ def _commit(laws, state, x1, work):
 
 
 @nb.njit(cache=True)
-def _output_step(model, laws, opts, state, x1, work, loads, w, t_off, N, k, stats):
+def _output_step(model, laws, opts, state, x1, work, loads, w, t_off, N, k, stats, Y):
     """One output step from global index ``k`` to ``k + 1`` in dyadic sub-steps; returns
     ``(0, 0.0)``, or ``(-1, t)`` when Newton fails at the finest sub-step starting at ``t``."""
     F2 = model[3]
@@ -124,6 +125,8 @@ def _output_step(model, laws, opts, state, x1, work, loads, w, t_off, N, k, stat
             continue
         stats[1] += 1
         _commit(laws, state, x1, work)
+        if Y.shape[0] > 0:
+            propagate(model, laws, opts, h, work, Y)
         pos += size
         while lev > 0 and pos % (size << 1) == 0:
             lev -= 1
@@ -133,7 +136,8 @@ def _output_step(model, laws, opts, state, x1, work, loads, w, t_off, N, k, stat
 
 @nb.njit(cache=True)
 def _work(laws, n, S, D):
-    """Scratch of one step: ``(S_trial, D_trial, Kt, z, A, B, Keff, R, Jinv, Kt_c, h_c, tmp)``."""
+    """Scratch of one step: ``(S_trial, D_trial, Kt, z, A, B, Keff, R, Jinv, Kt_c, h_c, tmp,
+    A per part, B per part)``."""
     s_off, g_off, vel = laws[3], laws[5], laws[6]
     ns_max = 1
     nin_max = 1
@@ -142,7 +146,8 @@ def _work(laws, n, S, D):
         nin_max = max(nin_max, _n_input(g_off[e + 1] - g_off[e], vel[e]))
     return (S.copy(), D.copy(), np.zeros((n, n)), np.zeros(nin_max), np.zeros((ns_max, ns_max)),
             np.zeros((ns_max, nin_max)), np.zeros((nin_max, nin_max)), np.zeros(n), np.zeros((n, n)),
-            np.full((n, n), np.nan), np.array([np.nan]), np.zeros(n))
+            np.full((n, n), np.nan), np.array([np.nan]), np.zeros(n),
+            np.zeros((vel.size, ns_max, ns_max)), np.zeros((vel.size, ns_max, nin_max)))
 
 
 @nb.njit(cache=True)
@@ -158,13 +163,15 @@ def _period_change(prev, cur):
 
 
 @nb.njit(cache=True)
-def march(model, laws, opts, run, state, rec, prev, cur, stats):
+def march(model, laws, opts, run, state, rec, prev, cur, stats, Y):
     """Integrate ``n_periods`` whole periods of ``N`` steps from global step ``k0``.
 
     ``run = (w, t_off, N, k0, n_periods, check, tol, have_prev)``.  The ``state`` tuple is
     updated in place.  ``rec[0]`` (mode) 0 records the current period in rows ``0..N``
     (overwritten every period); 1 records row ``k`` for global step ``k``.  With ``check``,
-    stops as soon as a period repeats the previous one to ``tol``.
+    stops as soon as a period repeats the previous one to ``tol``.  ``Y`` (m, m') is carried
+    through every committed step, ``Y <- (dy_1/dy_0) Y`` (:mod:`hbm.time_sensitivity`); an
+    array with no rows switches that off.
 
     Returns
     -------
@@ -191,7 +198,7 @@ def march(model, laws, opts, run, state, rec, prev, cur, stats):
         if row < n_rec:
             record(row, laws, q, v, S, rec)
         for j in range(1, N + 1):
-            status, t_fail = _output_step(model, laws, opts, state, x1, work, loads, w, t_off, N, k, stats)
+            status, t_fail = _output_step(model, laws, opts, state, x1, work, loads, w, t_off, N, k, stats, Y)
             if status < 0:
                 return -1, pp, change, t_fail
             k += 1

@@ -72,7 +72,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -81,138 +80,11 @@ from .case import Case, CaseError
 from .time_kernels import element_forces, init_states
 from .time_march import march
 from .time_parts import Packed, pack_elements
+from .shooting import floquet_verdict, shoot, start_sensitivity
+from .time_results import History, Run, TimeSimOptions, TimeSimResult
 
+__all__ = ["History", "Run", "TimeSimOptions", "TimeSimResult", "steady_state", "timesim", "transient"]
 
-
-@dataclass(frozen=True)
-class TimeSimOptions:
-    """Settings of the time integration.
-
-    Attributes
-    ----------
-    steps : int
-        Steps per excitation period ``n`` (the error estimate also runs ``2 n``).
-    tol : float
-        Periodicity tolerance: relative max change of ``q`` between successive periods.
-    max_periods : int
-        Most periods integrated per run (steady-state mode).
-    alpha : float
-        HHT parameter in [-1/3, 0]; 0 is Newmark average acceleration.
-    max_level : int
-        Finest sub-step ``dt / 2**max_level`` for locating element transitions.
-    jump_tol : float
-        Relative tangent jump that counts as an element status change.
-    newton_tol : float
-        Newton tolerance on the residual, relative to its largest term.
-    max_iter : int
-        Newton iterations per (sub-)step before the step is halved.
-    """
-
-    steps: int = 512
-    tol: float = 1e-8
-    max_periods: int = 5000
-    alpha: float = 0.0
-    max_level: int = 6
-    jump_tol: float = 0.3
-    newton_tol: float = 1e-10
-    max_iter: int = 30
-
-    def validate(self):
-        if not (isinstance(self.steps, (int, np.integer)) and self.steps >= 8):
-            raise CaseError(f"steps per period must be an integer >= 8, got {self.steps!r}")
-        if not (self.tol > 0 and math.isfinite(self.tol)):
-            raise CaseError(f"periodicity tolerance must be > 0, got {self.tol!r}")
-        if not (isinstance(self.max_periods, (int, np.integer)) and self.max_periods >= 2):
-            raise CaseError(f"max periods must be an integer >= 2, got {self.max_periods!r}")
-        if not -1.0 / 3.0 - 1e-12 <= self.alpha <= 0.0:
-            raise CaseError(f"HHT alpha must be in [-1/3, 0], got {self.alpha!r}")
-        if not 0 <= self.max_level <= 20:
-            raise CaseError(f"max_level must be in 0..20, got {self.max_level!r}")
-
-
-@dataclass(frozen=True)
-class History:
-    """Sampled time history.
-
-    Attributes
-    ----------
-    t : ndarray, shape (n_rows,)
-        Time, s.
-    q : ndarray, shape (n_rows, n_dof)
-    forces : ndarray, shape (n_rows, n_forces)
-        Element forces (every element's ``n_local`` components, in case order).
-    disp : ndarray, shape (n_rows, n_forces)
-        The matching element coordinates ``G q``.
-    force_names : tuple of str
-    vel : ndarray, shape (n_rows, n_forces)
-        The element coordinates' velocities ``G v`` (e.g. the relative sliding velocity).
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    forces: np.ndarray
-    disp: np.ndarray
-    force_names: tuple
-    vel: np.ndarray | None = None
-
-
-@dataclass(frozen=True)
-class Run:
-    """One integration at ``steps`` steps per period.
-
-    ``h1``/``max`` (per output name) are of the last period on the step grid.  ``converged``
-    is whether the periodicity test passed (steady mode; always False in transient mode, where
-    ``change`` is -1).  ``history`` is the last period (steady) or the whole run (transient).
-    """
-
-    freq_hz: float
-    steps: int
-    periods: int
-    converged: bool
-    change: float
-    h1: dict
-    max: dict
-    history: History
-    stats: dict
-    seconds: float
-
-
-@dataclass(frozen=True)
-class TimeSimResult:
-    """Result of :func:`timesim`: the ``2 n`` run's values with the ``n`` vs ``2 n`` estimate.
-
-    Attributes
-    ----------
-    h1, max : dict of str -> float
-        Per output, from the fine run.
-    error_estimate : float
-        Largest relative change of any output's ``h1`` or ``max`` between ``n`` and ``2 n``.
-    errors : dict of str -> (float, float)
-        Relative changes of ``(h1, max)`` per output.
-    periods : int
-        Periods integrated in total (both runs).
-    converged : bool
-        Both runs periodic to ``tol`` (steady mode); True in transient mode.
-    mode : str
-        ``"steady"`` or ``"transient"``.
-    """
-
-    freq_hz: float
-    h1: dict
-    max: dict
-    error_estimate: float
-    errors: dict
-    periods: int
-    converged: bool
-    mode: str
-    coarse: Run
-    fine: Run
-    seconds: float
-    switch_off_at: float | None = None
-
-    @property
-    def history(self) -> History:
-        return self.fine.history
 
 
 def _support(case: Case):
@@ -318,9 +190,13 @@ def _amplitudes(case: Case, hist: History, N: int):
     return h1, mx
 
 
+_NO_SENS = np.zeros((0, 0))
+
+
 def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off, state,
-               progress, period_offset=0):
-    """Run up to ``periods`` periods from ``state`` (updated in place); returns a :class:`Run`."""
+               progress, period_offset=0, sens=None):
+    """Run up to ``periods`` periods from ``state`` (updated in place); returns a :class:`Run`.
+    ``sens`` (m, m), if given, is carried through every step (:mod:`hbm.time_sensitivity`)."""
     w = 2.0 * np.pi * freq_hz
     N = int(steps)
     n = case.n_dof
@@ -356,7 +232,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
         tc = time.perf_counter()
         run = (w, t_off, N, done * N, chunk, bool(check), float(opts.tol), done > 0)
         status, pp, ch, t_fail = march(model, packed.laws, laws_opts, run, state.arrays(), rec,
-                                       prev, cur, stats)
+                                       prev, cur, stats, _NO_SENS if sens is None else sens)
         done += pp
         if ch >= 0:
             change = ch
@@ -382,6 +258,44 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     return Run(freq_hz, N, done, bool(status == 1), float(change), h1, mx, hist, st, secs)
 
 
+def _one_period(case, f, opts, steps, packed):
+    """``one_period(state, Y)`` for :func:`hbm.shooting.shoot`: one period in place, ``Y``
+    carried through it; returns the period's ``q`` (N + 1, n)."""
+    def one_period(state, Y):
+        return _integrate(case, f, opts, steps, 1, False, None, state, None, sens=Y).history.q
+    return one_period
+
+
+def _settle(case, f, opts: TimeSimOptions, steps, state, progress, period_offset=0) -> Run:
+    """Periodic steady state from ``state``: plain periods, and shooting when they have not
+    repeated after ``opts.shoot_after``; then plain periods confirm the periodicity test."""
+    first = min(opts.shoot_after, opts.max_periods)
+    run = _integrate(case, f, opts, steps, first, True, None, state, progress, period_offset)
+    if run.converged or first >= opts.max_periods:
+        return run
+    packed = pack_elements(case.elements, case.n_dof)
+    t0 = time.perf_counter()
+    shot = shoot(_one_period(case, f, opts, steps, packed), state, packed.laws, case.n_dof,
+                 2 * np.pi * f, _support(case)[0], opts.tol)
+    spent = run.periods + shot.iterations
+    last = _integrate(case, f, opts, steps, max(opts.max_periods - spent, 2), True, None, state,
+                      progress, period_offset + spent)
+    stats = {k: run.stats[k] + last.stats[k] for k in run.stats}
+    return dataclasses.replace(last, periods=spent + last.periods, stats=stats, shooting=shot,
+                               seconds=run.seconds + (time.perf_counter() - t0))
+
+
+def floquet(case: Case, freq_hz: float, state, options: TimeSimOptions, steps: int) -> tuple:
+    """``(stable, largest |mu|, multipliers)`` of the periodic solution through ``state``
+    (one period with sensitivities, :mod:`hbm.shooting`); ``state`` is advanced a period."""
+    packed = pack_elements(case.elements, case.n_dof)
+    Y = start_sensitivity(case.n_dof, state.S.size, _support(case)[0])
+    _one_period(case, freq_hz, options, steps, packed)(state, Y)
+    mu = np.linalg.eigvals(Y)
+    stable, big = floquet_verdict(mu)
+    return stable, big, mu
+
+
 def steady_state(case: Case, freq_hz: float, options: TimeSimOptions | None = None,
                  progress=None) -> Run:
     """Periodic steady state at ``freq_hz`` from rest with ``options.steps`` steps per period.
@@ -405,7 +319,7 @@ def steady_state(case: Case, freq_hz: float, options: TimeSimOptions | None = No
     f = _check_freq(freq_hz)
     _check_supported(case)
     state = _State(case, pack_elements(case.elements, case.n_dof), case.excitation.force, 2 * np.pi * f)
-    return _integrate(case, f, opts, opts.steps, opts.max_periods, True, None, state, progress)
+    return _settle(case, f, opts, opts.steps, state, progress)
 
 
 def transient(case: Case, freq_hz: float, periods: int, switch_off_at: float | None = None,
@@ -467,18 +381,19 @@ def timesim(case: Case, freq_hz: float, options: TimeSimOptions | None = None,
     if periods is None:
         packed = pack_elements(case.elements, case.n_dof)
         state = _State(case, packed, case.excitation.force, 2 * np.pi * f)
-        coarse = _integrate(case, f, opts, opts.steps, opts.max_periods, True, None, state, progress)
-        fine = _integrate(case, f, opts, 2 * opts.steps, opts.max_periods, True, None, state,
-                          progress, period_offset=coarse.periods)
+        coarse = _settle(case, f, opts, opts.steps, state, progress)
+        fine = _settle(case, f, opts, 2 * opts.steps, state, progress, period_offset=coarse.periods)
         mode, conv, total = "steady", coarse.converged and fine.converged, coarse.periods + fine.periods
+        stability = floquet(case, f, state, opts, 2 * opts.steps) if opts.floquet else None
     else:
         coarse = transient(case, f, periods, switch_off_at, opts, progress)
         fine = transient(case, f, periods, switch_off_at,
                          dataclasses.replace(opts, steps=2 * opts.steps), progress)
         mode, conv, total = "transient", True, int(periods)
+        stability = None
     errs, est = _relative_changes(coarse, fine)
     if not all(math.isfinite(v) for v in list(fine.h1.values()) + list(fine.max.values())):
         raise RuntimeError(f"the integration at {f:g} Hz produced non-finite amplitudes (overflow): "
                            f"check the model's units and the frequency")
     return TimeSimResult(f, dict(fine.h1), dict(fine.max), est, errs, int(total), bool(conv), mode,
-                         coarse, fine, time.perf_counter() - t0, switch_off_at)
+                         coarse, fine, time.perf_counter() - t0, switch_off_at, stability)

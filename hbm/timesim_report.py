@@ -19,11 +19,13 @@ def write_summary_csv(case, res, path: Path) -> None:
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")]
-                   + ["error_estimate", "periods"])
+                   + ["error_estimate", "periods", "floquet_max", "stable"])
         row = [f"{res.freq_hz:.10g}"]
         for n in names:
             row += [f"{res.h1[n]:.10g}", f"{res.max[n]:.10g}"]
         row += [f"{res.error_estimate:.3e}", str(int(res.periods))]
+        fl = res.floquet
+        row += ["", ""] if fl is None else [f"{fl[1]:.9f}", str(int(bool(fl[0])))]
         w.writerow(row)
 
 

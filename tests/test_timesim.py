@@ -105,11 +105,17 @@ def test_transient_free_decay_friction_arrests_slip():
     assert amp[-1] < 0.5 * amp_on, (amp[-1], amp_on)
     # (amplitudes from the sampled peaks: tolerance of the peak sampling, ~(w dt)^2 / 8)
     assert np.all(np.diff(amp[P_off + 1:]) <= 1e-3 * amp[P_off + 2:])
-    # ... until the slider sticks for good: its position u - f/kt no longer moves (the force
-    # still touches the limit at the reversal where it stuck, from inside)
+    # ... until the slider sticks for good: its position u - f/kt no longer moves.  The force
+    # touches the limit at every reversal (undamped after sticking); as the sampling phase
+    # drifts, a later sample may land nearer the peak and slip by at most the peak-sampling
+    # error of the force, (w dt)^2 / 8 of its amplitude (measured: one slip of 3.6e-9 amp_on
+    # in the last 10 periods with newton_tol 1e-12, none with 1e-10)
     tail = slice((P - 10) * N, None)
     slider = h.disp[:, 0] - f / p["kt"]
-    assert np.ptp(slider[tail]) < 1e-9 * amp_on
+    w_free = np.sqrt((p["k"] + p["kt"]) / p["m"])
+    sampling = (w_free * T / N) ** 2 / 8 * 0.5 * np.ptp(f[tail]) / p["kt"]
+    assert np.ptp(slider[tail]) <= sampling, (np.ptp(slider[tail]), sampling)
+    assert np.ptp(slider[tail]) < 1e-5 * np.ptp(slider[P_off * N:])
     assert np.ptp(slider[P_off * N:]) > 1.0                  # it did slip after switch-off
     assert np.abs(f).max() <= p["fs"] * (1 + 1e-12)
     # then linear and undamped: constant amplitude (average acceleration adds no damping)
@@ -214,13 +220,15 @@ def test_cli_writes_files(tmp_path):
     case = tmp_path / "case.toml"
     case.write_text(CASE)
     out = tmp_path / "out"
-    r = run("timesim", str(case), "--freq-hz", "0.2", "-o", str(out), "--steps", "64", "--tol", "1e-7")
+    r = run("timesim", str(case), "--freq-hz", "0.2", "-o", str(out), "--steps", "64", "--tol", "1e-7",
+            "--floquet")
     assert r.returncode == 0, r.stderr
     rows = list(csv.reader(open(out / "timesim.csv")))
-    assert rows[0] == ["freq_hz", "x_h1", "x_max", "error_estimate", "periods"]
+    assert rows[0] == ["freq_hz", "x_h1", "x_max", "error_estimate", "periods", "floquet_max", "stable"]
     assert len(rows) == 2
     vals = [float(v) for v in rows[1]]
     assert vals[0] == 0.2 and vals[1] > 0 and vals[2] >= vals[1] * 0.9 and 0 < vals[3] < 0.05 and vals[4] > 2
+    assert 0 < vals[5] < 1 and vals[6] == 1 and "Floquet: largest |multiplier|" in r.stdout
     hist = list(csv.reader(open(out / "history.csv")))
     assert hist[0] == ["t", "x", "jenkins0_f", "jenkins0_u", "jenkins0_v"] and len(hist) == 2 + 128   # last period at 2n steps
     assert (out / "timesim.png").stat().st_size > 1000
