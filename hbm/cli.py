@@ -188,6 +188,10 @@ def cmd_frf(args) -> int:
             print(f"  warning: {st[key]}", file=sys.stderr)
     if summary["max_energy_error"] is not None:
         print(f"  max energy-balance error {summary['max_energy_error']:.2e}")
+    if st.get("floquet_overrides_hz"):
+        fl = st["floquet_overrides_hz"]
+        print(f"  note: {len(fl)} point(s) Hill called unstable are stable by the Floquet multipliers of the "
+              f"time-domain period map (at {', '.join(f'{f:.6g}' for f in fl[:5])} Hz); the verdicts are Floquet's")
     if st.get("stuck_points"):
         print(f"  note: at {st['stuck_points']} points a contact sticks for the whole period: its slider offset, "
               f"hence the mean and max |y|, is one of a family of periodic solutions (column stuck_contacts)")
@@ -258,7 +262,8 @@ def cmd_timesim(args) -> int:
         if run.shooting is not None:
             print(f"  {run.steps} steps: {run.shooting.message}")
     if res.floquet is not None:
-        verdict = "stable" if res.floquet[0] else "UNSTABLE"
+        verdict = "UNSTABLE" if not res.floquet[0] else (
+            "stable (neutral multipliers of 1: a contact stuck all period)" if res.floquet[1] > 1 - 1e-9 else "stable")
         print(f"  Floquet: largest |multiplier| {res.floquet[1]:.6f}: {verdict}")
     print(f"  wrote {args.out}/timesim.csv, history.csv, timesim.png")
     if not res.converged:

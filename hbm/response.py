@@ -21,6 +21,7 @@ from continuation.linsolve import REUSE_MIN_SIZE, ReusedLU
 from .case import Case
 from .element_outputs import element_output_series
 from .energy import energy_balance
+from .floquet_check import confirm_unstable
 from .fourier import FourierBasis, max_abs
 from .jumps import predict_jumps
 from .newton import newton
@@ -316,6 +317,8 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     freq_hz = np.array(pts_w) / (2 * np.pi)
     jumps = None
     if stable is not None:
+        if choose_solver(case) == "full":
+            stable = confirm_unstable(case, basis, Xs, freq_hz, stable, settings)
         land = _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
         jumps = {}
         for i, name in enumerate(case.analysis.outputs):

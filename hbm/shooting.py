@@ -11,7 +11,10 @@ tangents (:mod:`hbm.time_sensitivity`):
 
 solved in least squares on scaled unknowns: a contact stuck all period leaves a neutral
 direction (a constant slider offset gives another periodic solution, multiplier exactly 1),
-so ``Y - I`` is singular there and the minimum-norm step keeps the nearest orbit.
+so ``Y - I`` is singular there and the minimum-norm step keeps the nearest orbit.  The map
+is only piecewise smooth (stick/slip and contact transitions): a step that raises the
+residual to more than ``GROWTH`` times the best so far is shortened (by 4, down to 1/64)
+from the best point.
 
 The eigenvalues ``mu`` of ``Y`` at the periodic solution are its Floquet multipliers: the
 solution is asymptotically stable when every ``|mu| < 1`` apart from the neutral ones;
@@ -27,6 +30,8 @@ from .time_kernels import element_forces
 
 FLOQUET_MARGIN = 1e-6      # |mu| above 1 + this is growth (round-off of the product ~1e-10)
 MAX_NEWTON = 12            # shooting iterations before giving up (quadratic: 3-5 usually)
+MIN_DAMPING = 1.0 / 64     # shortest Newton step tried (a quarter at each worse residual)
+GROWTH = 10.0              # a residual this many times the best so far shortens the step
 
 
 @dataclass(frozen=True)
@@ -124,7 +129,8 @@ def shoot(one_period, state, laws, n: int, w: float, fixed: np.ndarray, tol: flo
     """
     n_s = state.S.size
     residuals = []
-    best = (np.inf, state_vector(state))
+    best = None                  # (residual, y, Newton step) of the best point so far
+    lam = 1.0
     mult = np.zeros(0, dtype=complex)
     for it in range(1, max_iter + 1):
         y0 = state_vector(state)
@@ -137,15 +143,22 @@ def shoot(one_period, state, laws, n: int, w: float, fixed: np.ndarray, tol: flo
         mult = np.linalg.eigvals(Y)
         if res <= tol:
             return ShootingResult(True, it, tuple(residuals), mult, f"periodic after {it} shooting periods")
-        if res < best[0]:
-            best = (res, y0)
-        elif res > 10.0 * best[0]:
+        if best is None or res <= GROWTH * best[0]:
+            d = _scales(y0, y1, Y, n, w, q_peak)
+            A = (Y - np.eye(Y.shape[0])) * d[None, :] / d[:, None]
+            step = np.linalg.lstsq(A, -(y1 - y0) / d, rcond=1e-12)[0] * d
+            if best is None or res < best[0]:
+                best = (res, y0, step)
+            lam = 1.0
+            set_state(state, y0 + step, laws)
+            continue
+        lam *= 0.25              # far worse than the best: a shorter step from it
+        if lam < MIN_DAMPING:
             set_state(state, best[1], laws)
             return ShootingResult(False, it, tuple(residuals), mult,
-                                  f"shooting diverged (residual {res:.3g} after {best[0]:.3g})")
-        d = _scales(y0, y1, Y, n, w, q_peak)
-        A = (Y - np.eye(Y.shape[0])) * d[None, :] / d[:, None]
-        step = np.linalg.lstsq(A, -(y1 - y0) / d, rcond=1e-12)[0] * d
-        set_state(state, y0 + step, laws)
+                                  f"shooting stalled at residual {best[0]:.3g} (steps shortened to "
+                                  f"{MIN_DAMPING:g} of Newton's did not reduce it)")
+        set_state(state, best[1] + lam * best[2], laws)
+    set_state(state, best[1], laws)
     return ShootingResult(False, max_iter, tuple(residuals), mult,
-                          f"shooting did not reach {tol:g} in {max_iter} periods (last {residuals[-1]:.3g})")
+                          f"shooting did not reach {tol:g} in {max_iter} periods (best {best[0]:.3g})")
