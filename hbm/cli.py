@@ -270,6 +270,9 @@ def cmd_timesim(args) -> int:
         sys.stderr.write(f"hbm: timesim: no periodic steady state within {opts.max_periods} periods "
                          f"(last relative change {max(res.coarse.change, res.fine.change):.2e} > tol {opts.tol:g}); "
                          f"results are of the last period\n")
+        shot = next((r.shooting for r in (res.fine, res.coarse) if r.shooting is not None and not r.converged), None)
+        if shot is not None:
+            sys.stderr.write(f"hbm: timesim: {shot.message}\n")
         return 1
     return 0
 

@@ -100,7 +100,7 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
     ValueError
         Support excitation or velocity-dependent laws (not handled here).
     """
-    from .timesim import _State, _one_period, _support
+    from .timesim import _State, _one_period, kernel_model
     if case.excitation.base is not None:
         raise ValueError("the Floquet check of a balance point does not handle support excitation")
     w = 2.0 * np.pi * freq_hz
@@ -115,7 +115,7 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
         periods.append(q)
         return q
 
-    shot = shoot(one_period, state, packed.laws, case.n_dof, w, _support(case)[0], tol, max_iter)
+    shot = shoot(one_period, state, kernel_model(case), packed.laws, w, tol, max_iter)
     stable, big = floquet_verdict(shot.multipliers)
     theta = 2.0 * np.pi * np.arange(steps + 1) / steps
     q_hb = basis_matrix(basis.h_of_row, theta) @ X

@@ -80,7 +80,7 @@ from .case import Case, CaseError
 from .time_kernels import element_forces, init_states
 from .time_march import march
 from .time_parts import Packed, pack_elements
-from .shooting import floquet_verdict, shoot, start_sensitivity
+from .shooting import MAX_NEWTON, Balance, floquet_verdict, reduced_monodromy, shoot, start_sensitivity
 from .time_results import History, Run, TimeSimOptions, TimeSimResult
 
 __all__ = ["History", "Run", "TimeSimOptions", "TimeSimResult", "steady_state", "timesim", "transient"]
@@ -193,6 +193,14 @@ def _amplitudes(case: Case, hist: History, N: int):
 _NO_SENS = np.zeros((0, 0))
 
 
+def kernel_model(case: Case) -> tuple:
+    """``(M, C, K, F2, fixed, ybase)``, the kernels' model tuple (:mod:`hbm.time_kernels`)."""
+    fixed, ybase = _support(case)
+    return (np.ascontiguousarray(case.model.M, dtype=float), np.ascontiguousarray(case.model.C, dtype=float),
+            np.ascontiguousarray(case.model.K, dtype=float),
+            np.ascontiguousarray(case.excitation.cos_sin, dtype=float), fixed, ybase)
+
+
 def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off, state,
                progress, period_offset=0, sens=None):
     """Run up to ``periods`` periods from ``state`` (updated in place); returns a :class:`Run`.
@@ -202,10 +210,6 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     n = case.n_dof
     packed = pack_elements(case.elements, n)
     n_f = packed.g_out.shape[0]
-    M = np.ascontiguousarray(case.model.M, dtype=float)
-    C = np.ascontiguousarray(case.model.C, dtype=float)
-    K = np.ascontiguousarray(case.model.K, dtype=float)
-    F2 = np.ascontiguousarray(case.excitation.cos_sin, dtype=float)
     rows = N + 1 if check else periods * N + 1
     need = 8.0 * rows * (n + 3 * n_f) + 8.0 * 4 * n * n
     if need > MEMORY_SHARE * machine_memory():
@@ -215,8 +219,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     rec_f = np.zeros((rows, n_f))
     rec_u = np.zeros((rows, n_f))
     rec_v = np.zeros((rows, n_f))
-    fixed, ybase = _support(case)
-    model = (M, C, K, F2, fixed, ybase)
+    model = kernel_model(case)
     laws_opts = (float(opts.alpha), float(opts.newton_tol), int(opts.max_iter), int(opts.max_level),
                  float(opts.jump_tol))
     rec = (0 if check else 1, rec_q, rec_f, rec_u, rec_v) + packed.record_map()
@@ -266,32 +269,53 @@ def _one_period(case, f, opts, steps, packed):
     return one_period
 
 
+SHOOT_START = 1e-3     # periodicity change below which shooting gets its full iterations
+FAR_ITERATIONS = 4     # shooting iterations tried from further away
+
+
 def _settle(case, f, opts: TimeSimOptions, steps, state, progress, period_offset=0) -> Run:
     """Periodic steady state from ``state``: plain periods, and shooting when they have not
-    repeated after ``opts.shoot_after``; then plain periods confirm the periodicity test."""
+    repeated after ``opts.shoot_after``.  From a change above ``SHOOT_START`` shooting gets
+    ``FAR_ITERATIONS`` (a beating undamped mode converges at once; a stick-slip period map far
+    from its orbit makes Newton wander), and if that fails, plain periods bring the change
+    below ``SHOOT_START`` for a second attempt.  Plain periods confirm the periodicity test."""
     first = min(opts.shoot_after, opts.max_periods)
-    run = _integrate(case, f, opts, steps, first, True, None, state, progress, period_offset)
-    if run.converged or first >= opts.max_periods:
-        return run
+    runs = [_integrate(case, f, opts, steps, first, True, None, state, progress, period_offset)]
+    if runs[0].converged or first >= opts.max_periods:
+        return runs[0]
     packed = pack_elements(case.elements, case.n_dof)
     t0 = time.perf_counter()
-    shot = shoot(_one_period(case, f, opts, steps, packed), state, packed.laws, case.n_dof,
-                 2 * np.pi * f, _support(case)[0], opts.tol)
-    spent = run.periods + shot.iterations
+
+    def attempt(change):
+        iters = MAX_NEWTON if change <= SHOOT_START else FAR_ITERATIONS
+        return shoot(_one_period(case, f, opts, steps, packed), state, kernel_model(case), packed.laws,
+                     2 * np.pi * f, opts.tol, iters)
+
+    shots = [attempt(runs[0].change)]
+    if not shots[0].converged and runs[0].change > SHOOT_START:
+        spent = first + shots[0].iterations
+        near = dataclasses.replace(opts, tol=max(SHOOT_START, opts.tol))
+        runs.append(_integrate(case, f, near, steps, max(opts.max_periods - spent, 2), True, None, state,
+                               progress, period_offset + spent))
+        if runs[-1].converged:
+            shots.append(attempt(runs[-1].change))
+    spent = sum(r.periods for r in runs) + sum(sh.iterations for sh in shots)
     last = _integrate(case, f, opts, steps, max(opts.max_periods - spent, 2), True, None, state,
                       progress, period_offset + spent)
-    stats = {k: run.stats[k] + last.stats[k] for k in run.stats}
-    return dataclasses.replace(last, periods=spent + last.periods, stats=stats, shooting=shot,
-                               seconds=run.seconds + (time.perf_counter() - t0))
+    stats = {k: sum(r.stats[k] for r in runs) + last.stats[k] for k in last.stats}
+    return dataclasses.replace(last, periods=spent + last.periods, stats=stats, shooting=shots[-1],
+                               seconds=sum(r.seconds for r in runs) + (time.perf_counter() - t0))
 
 
 def floquet(case: Case, freq_hz: float, state, options: TimeSimOptions, steps: int) -> tuple:
     """``(stable, largest |mu|, multipliers)`` of the periodic solution through ``state``
     (one period with sensitivities, :mod:`hbm.shooting`); ``state`` is advanced a period."""
     packed = pack_elements(case.elements, case.n_dof)
-    Y = start_sensitivity(case.n_dof, state.S.size, _support(case)[0])
+    model = kernel_model(case)
+    Y = start_sensitivity(case.n_dof, state.S.size, model[4])
     _one_period(case, freq_hz, options, steps, packed)(state, Y)
-    mu = np.linalg.eigvals(Y)
+    balance = Balance(model, packed.laws, 2 * np.pi * freq_hz)
+    mu = np.linalg.eigvals(reduced_monodromy(Y, balance, case.n_dof))
     stable, big = floquet_verdict(mu)
     return stable, big, mu
 
