@@ -52,6 +52,17 @@ def write_history_csv(case, res, path: Path) -> None:
             w.writerow([f"{x:.10g}" for x in r])
 
 
+def _dissipative(hist) -> list:
+    """Force components whose loop encloses work (``|sum f du|`` above 1e-3 of the largest
+    ``ptp(f) ptp(u)``): a wedge's normal springs would flatten its friction loops; all
+    components if none does."""
+    f, u = hist.forces, hist.disp
+    work = np.abs(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(u, axis=0), axis=0))
+    box = np.ptp(f, axis=0) * np.ptp(u, axis=0)
+    keep = [i for i in range(f.shape[1]) if work[i] > 1e-3 * box.max(initial=0.0)]
+    return keep or list(range(f.shape[1]))
+
+
 def write_plot(case, res, path: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
@@ -72,11 +83,14 @@ def write_plot(case, res, path: Path) -> None:
     ax.legend(fontsize=8)
     if n_f:
         ax = axes[0, 1]
-        for i, name in enumerate(hist.force_names):
-            ax.plot(hist.disp[:, i], hist.forces[:, i], lw=0.9, label=name)
+        shown = _dissipative(hist)
+        for i in shown:
+            ax.plot(hist.disp[:, i], hist.forces[:, i], lw=0.9, label=hist.force_names[i])
         ax.set_xlabel("element coordinate u")
         ax.set_ylabel("element force f")
-        ax.set_title("hysteresis (force against displacement)", fontsize=9)
+        note = "" if len(shown) == n_f else f" ({n_f - len(shown)} elastic components not drawn)"
+        ax.set_title(f"hysteresis (force against displacement){note}", fontsize=9)
+        ax.ticklabel_format(style="sci", scilimits=(-3, 4))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
