@@ -32,9 +32,9 @@ from .problem_setup import (_first_point, _residual_scale, _stuck_damping, _stuc
                             recover_outputs, resolve_settings, setting_sources, solve_at)
 from .result import FRFResult, OutputSeries
 from .resonances import ResonanceStepLimit, linear_resonances
-from .stability import HillSystem, StabilityOptions, point_is_stable
-from .stability_path import hill_margin, path_stability
+from .stability import StabilityOptions
 from .stuck import stuck_contacts
+from .verdicts import landing_solver, path_verdicts
 from .truncation import MAX_UNKNOWNS, SMALL_ERROR, WARN_ERROR, richer_basis, truncation_errors
 
 __all__ = ["frf", "FRFResult", "OutputSeries", "build_problem", "choose_solver", "output_amplitudes",
@@ -291,7 +291,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     if stability:
         if progress is not None:
             progress(len(pts_w), None)
-        stable, margin = _path_verdicts(problem, pts_X, np.array(pts_w), segments, stability_options)
+        stable, margin = path_verdicts(problem, pts_X, np.array(pts_w), segments, stability_options)
         settings["stability_spectra"] = int(np.isfinite(margin).sum())
         growth = margin / np.array(pts_w)
         settings["stability_max_growth"] = float(np.nanmax(growth)) if np.isfinite(margin).any() else None
@@ -319,7 +319,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     if stable is not None:
         if choose_solver(case) == "full":
             stable = confirm_unstable(case, basis, Xs, freq_hz, stable, settings)
-        land = _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
+        land = landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
         jumps = {}
         for i, name in enumerate(case.analysis.outputs):
             def refine(i0, i1, f, i=i):
@@ -374,53 +374,3 @@ def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
             f"estimated error of {n} up to {v['error']:.1%} at {v['freq_hz']:.6g} Hz from the harmonic "
             f"truncation (H = {int(problem.basis.harmonics.max())}): raise harmonics")
     return out
-
-
-def _path_verdicts(problem, Xs, ws, segments, options):
-    """Hill verdicts of every point, segment by segment (:func:`hbm.stability_path.path_stability`).
-
-    Returns
-    -------
-    stable : ndarray of bool, shape (n_points,)
-    margin : ndarray, shape (n_points,)
-        ``max Re(lambda) - tol w`` where a spectrum was computed, NaN elsewhere.
-    """
-    opts = options or StabilityOptions()
-    hill = HillSystem(problem)
-    stable = np.ones(ws.size, dtype=bool)
-    margin = np.full(ws.size, np.nan)
-    for a, b in segments:
-        def test(k, a=a):
-            w = float(ws[a + k])
-            return hill_margin(*hill(Xs[a + k], w), hill.basis, w, opts)
-        stable[a:b], margin[a:b] = path_stability(test, ws[a:b], opts.max_skip)
-    return stable, margin
-
-
-def _landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
-    """``land(i0, i1, f_hz) -> X`` (n_coef, n) or ``None``: the stable solution at ``f_hz``
-    by Newton from the path interpolated linearly between points ``i0`` and ``i1``.
-
-    Results are cached (one solve per landing, shared by all outputs); ``None`` when Newton
-    fails or lands on an unstable solution.
-    """
-    cache = {}
-
-    def land(i0, i1, f_hz):
-        key = (i0, i1, float(f_hz))
-        if key not in cache:
-            w = 2 * np.pi * f_hz
-            df = freq_hz[i1] - freq_hz[i0]
-            t = 0.0 if df == 0 else min(max((f_hz - freq_hz[i0]) / df, 0.0), 1.0)
-            X0 = Xs[i0] + t * (Xs[i1] - Xs[i0])
-            fun = lambda x: problem.residual(problem.expand(x), w)[:2]
-            res = newton(fun, problem.unknowns(X0), scale=xscale, r_scale=r_scale)
-            X = problem.expand(res.x) if res.converged else None
-            if X is not None and not point_is_stable(problem, X, w, stability_options):
-                X = None
-            cache[key] = X
-        return cache[key]
-
-    return land
-
-
