@@ -55,6 +55,9 @@ From rest (``q = 0``, ``q' = 0``, element rest states from :func:`elements.kerne
 at zero coordinates), whole periods are integrated until the relative change of ``q`` (all
 DOFs, all samples of the step grid) between successive periods,
 ``max|q_p - q_{p-1}| / max|q_p|``, is at most ``tol`` (default 1e-8), or ``max_periods``.
+When the periods have not repeated after ``shoot_after`` (default 200), the periodic solution
+is sought by shooting, Newton's method on the period map with its exact monodromy matrix
+(:mod:`hbm.shooting`, :mod:`hbm.time_sensitivity`); plain periods then confirm the test.
 Outputs per case output: ``h1 = sqrt(a^2 + b^2)`` with ``a, b = 2/N sum q_j (cos, sin)(2 pi j/N)``
 over the last period's step grid, and ``max = max |q_j|`` over the same samples.
 
@@ -64,8 +67,8 @@ of the ``2 n`` run with the relative change ``|y_2n - y_n| / |y_2n|`` (largest o
 outputs' ``h1`` and ``max``) as its error estimate.  The scheme is second order, so this
 overestimates the error of the ``2 n`` result (by about 3x for smooth motion).
 
-Everything per time step runs in one numba kernel (:func:`_march`); Python only loops over
-chunks of whole periods (for progress output).
+Everything per time step runs in one numba kernel (:func:`hbm.time_march.march`); Python
+only loops over chunks of whole periods (for progress output).
 """
 from __future__ import annotations
 
