@@ -289,19 +289,27 @@ def _settle(case, f, opts: TimeSimOptions, steps, state, progress, period_offset
     packed = pack_elements(case.elements, case.n_dof)
     t0 = time.perf_counter()
 
-    def attempt(change):
+    def attempt(change, done):
         iters = MAX_NEWTON if change <= SHOOT_START else FAR_ITERATIONS
-        return shoot(_one_period(case, f, opts, steps, packed), state, kernel_model(case), packed.laws,
-                     2 * np.pi * f, opts.tol, iters)
+        base = _one_period(case, f, opts, steps, packed)
+        count = [period_offset + done]
 
-    shots = [attempt(runs[0].change)]
+        def one_period(st, Y):          # a shooting period can take seconds: report each
+            q = base(st, Y)
+            count[0] += 1
+            if progress is not None:
+                progress(count[0], -1.0)
+            return q
+        return shoot(one_period, state, kernel_model(case), packed.laws, 2 * np.pi * f, opts.tol, iters)
+
+    shots = [attempt(runs[0].change, first)]
     if not shots[0].converged and runs[0].change > SHOOT_START:
         spent = first + shots[0].iterations
         near = dataclasses.replace(opts, tol=max(SHOOT_START, opts.tol))
         runs.append(_integrate(case, f, near, steps, max(opts.max_periods - spent, 2), True, None, state,
                                progress, period_offset + spent))
         if runs[-1].converged:
-            shots.append(attempt(runs[-1].change))
+            shots.append(attempt(runs[-1].change, spent + runs[-1].periods))
     spent = sum(r.periods for r in runs) + sum(sh.iterations for sh in shots)
     last = _integrate(case, f, opts, steps, max(opts.max_periods - spent, 2), True, None, state,
                       progress, period_offset + spent)
