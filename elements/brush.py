@@ -61,7 +61,9 @@ import numpy as np
 
 from .base import (Element, LawSpec, coordinate_rows, require_keys, positive, non_negative, finite,
                    principal_reversal)
+from .friction3d import Friction3D
 from .hertz import hertz_contact
+from .kinds import FRICTION3D
 
 
 def static_approach(h: np.ndarray, weight: np.ndarray, kn: float, load: float) -> float:
@@ -248,8 +250,6 @@ class Brush(Element):
         contact-centre coordinates ``T z``, so ``R_b = [I_nt 0; c_b] T``; a bristle standing
         for ``w_b`` identical ones has ``w_b kt``, ``w_b kn`` and ``w_b p_b`` (the law is
         homogeneous of degree one in them), the same forces as the harmonic march."""
-        from .friction3d import Friction3D
-        from .kinds import FRICTION3D
         nt, nl = self.n_tangential, self.n_local
         parts = []
         for c, w, p in zip(self._coef, self._weight, self._pre):

@@ -77,9 +77,9 @@ def _start_states(packed, G_all_q: np.ndarray):
     return S
 
 
-def start_state(case, basis: FourierBasis, X: np.ndarray, w: float, steps: int) -> np.ndarray:
-    """``y = [q, v, a, S]`` at phase 0 of the balance point ``X`` (n_coef, n_dof)."""
-    packed = pack_elements(case.elements, case.n_dof)
+def start_state(packed, basis: FourierBasis, X: np.ndarray, w: float, steps: int) -> np.ndarray:
+    """``y = [q, v, a, S]`` at phase 0 of the balance point ``X`` (n_coef, n_dof) of a model
+    whose law parts are ``packed`` (:func:`hbm.time_parts.pack_elements`)."""
     if np.any(packed.laws[6]):
         raise ValueError("the Floquet check of a balance point does not handle velocity-dependent laws")
     theta = 2.0 * np.pi * np.arange(steps) / steps
@@ -105,8 +105,8 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
         raise ValueError("the Floquet check of a balance point does not handle support excitation")
     w = 2.0 * np.pi * freq_hz
     packed = pack_elements(case.elements, case.n_dof)
-    state = _State(case, packed, case.excitation.force, w)
-    set_state(state, start_state(case, basis, X, w, steps), packed.laws)
+    state = _State(case, packed, w)
+    set_state(state, start_state(packed, basis, X, w, steps), packed.laws)
     opts = TimeSimOptions(steps=steps)
     periods = []
 

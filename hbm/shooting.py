@@ -28,6 +28,7 @@ solution is asymptotically stable when every ``|mu| < 1`` apart from the neutral
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -108,18 +109,22 @@ class Balance:
 
     def __init__(self, model, laws, w):
         M, C, K, F2, fixed, ybase = model
-        n = M.shape[0]
         self.fr = np.flatnonzero(fixed == 0)
         self.fx = np.flatnonzero(fixed)
         self.M, self.C, self.K, self.F0 = M, C, K, F2[0]
         self.a_fixed = -w * w * ybase[self.fx]
-        self.GP = force_map(laws, n)
-        lu = np.linalg.inv(M[np.ix_(self.fr, self.fr)])
-        self.J = np.zeros((n, 2 * n + self.GP.shape[1]))
-        self.J[self.fr] = -lu @ np.hstack([K, C, self.GP])[self.fr]
-        self.Minv = lu
+        self.GP = force_map(laws, M.shape[0])
+        self.Minv = np.linalg.inv(M[np.ix_(self.fr, self.fr)])
+
+    @cached_property
+    def J(self) -> np.ndarray:
+        """``da/d[q, v, S]`` (n, 2 n + n_S), zero on support rows."""
+        J = np.zeros((self.M.shape[0], 2 * self.M.shape[0] + self.GP.shape[1]))
+        J[self.fr] = -self.Minv @ np.hstack([self.K, self.C, self.GP])[self.fr]
+        return J
 
     def acceleration(self, q, v, S):
+        """``a`` (n,) that balances the equations at phase 0 for ``q``, ``v``, ``S``."""
         a = np.zeros_like(q)
         a[self.fx] = self.a_fixed
         rhs = self.F0 - self.C @ v - self.K @ q - self.GP @ S - self.M[:, self.fx] @ a[self.fx]

@@ -130,8 +130,9 @@ def _eval_elements(q, v, c1, laws, S, work, fnl):
         B = Bbuf[:ns, :nin]
         law_step(kinds[e], p_all[p_off[e]:p_off[e + 1]], S[s0:s0 + ns], z[:nin],
                  S_trial[s0:s0 + ns], A, B)
-        work[12][e, :ns, :ns] = A           # kept for the step's sensitivity
-        work[13][e, :ns, :nin] = B
+        if work[12].shape[0] > 0:           # kept for the step's sensitivity (when carried)
+            work[12][e, :ns, :ns] = A
+            work[13][e, :ns, :nin] = B
         d0 = d_off[e]
         for i in range(nl):
             for j in range(nin):

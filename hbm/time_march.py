@@ -135,19 +135,20 @@ def _output_step(model, laws, opts, state, x1, work, loads, w, t_off, N, k, stat
 
 
 @nb.njit(cache=True)
-def _work(laws, n, S, D):
+def _work(laws, n, S, D, keep):
     """Scratch of one step: ``(S_trial, D_trial, Kt, z, A, B, Keff, R, Jinv, Kt_c, h_c, tmp,
-    A per part, B per part)``."""
+    A per part, B per part)``; the last two have no parts unless ``keep`` (sensitivities)."""
     s_off, g_off, vel = laws[3], laws[5], laws[6]
     ns_max = 1
     nin_max = 1
     for e in range(vel.size):
         ns_max = max(ns_max, s_off[e + 1] - s_off[e])
         nin_max = max(nin_max, _n_input(g_off[e + 1] - g_off[e], vel[e]))
+    n_keep = vel.size if keep else 0
     return (S.copy(), D.copy(), np.zeros((n, n)), np.zeros(nin_max), np.zeros((ns_max, ns_max)),
             np.zeros((ns_max, nin_max)), np.zeros((nin_max, nin_max)), np.zeros(n), np.zeros((n, n)),
             np.full((n, n), np.nan), np.array([np.nan]), np.zeros(n),
-            np.zeros((vel.size, ns_max, ns_max)), np.zeros((vel.size, ns_max, nin_max)))
+            np.zeros((n_keep, ns_max, ns_max)), np.zeros((n_keep, ns_max, nin_max)))
 
 
 @nb.njit(cache=True)
@@ -187,7 +188,7 @@ def march(model, laws, opts, run, state, rec, prev, cur, stats, Y):
     w, t_off, N, k0, n_periods, check, tol, have_prev = run
     q, v, S, D = state[0], state[1], state[4], state[5]
     n = q.size
-    work = _work(laws, n, S, D)
+    work = _work(laws, n, S, D, Y.shape[0] > 0)
     x1 = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n))
     loads = (np.zeros(n), np.zeros(n))
     n_rec = rec[1].shape[0]

@@ -57,18 +57,20 @@ class TimeSimOptions:
     floquet: bool = False
 
     def validate(self):
-        if not (isinstance(self.steps, (int, np.integer)) and self.steps >= 8):
-            raise CaseError(f"steps per period must be an integer >= 8, got {self.steps!r}")
+        _whole("steps per period", self.steps, 8)
         if not (self.tol > 0 and math.isfinite(self.tol)):
             raise CaseError(f"periodicity tolerance must be > 0, got {self.tol!r}")
-        if not (isinstance(self.max_periods, (int, np.integer)) and self.max_periods >= 2):
-            raise CaseError(f"max periods must be an integer >= 2, got {self.max_periods!r}")
+        _whole("max periods", self.max_periods, 2)
         if not -1.0 / 3.0 - 1e-12 <= self.alpha <= 0.0:
             raise CaseError(f"HHT alpha must be in [-1/3, 0], got {self.alpha!r}")
-        if not (isinstance(self.shoot_after, (int, np.integer)) and self.shoot_after >= 1):
-            raise CaseError(f"shoot_after must be an integer >= 1, got {self.shoot_after!r}")
+        _whole("shoot_after", self.shoot_after, 1)
         if not 0 <= self.max_level <= 20:
             raise CaseError(f"max_level must be in 0..20, got {self.max_level!r}")
+
+
+def _whole(name, value, low):
+    if not (isinstance(value, (int, np.integer)) and value >= low):
+        raise CaseError(f"{name} must be an integer >= {low}, got {value!r}")
 
 
 @dataclass(frozen=True)

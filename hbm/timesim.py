@@ -112,7 +112,7 @@ class _State:
     run does not begin with a jolt.
     """
 
-    def __init__(self, case: Case, packed: Packed, F: np.ndarray, w: float = 0.0):
+    def __init__(self, case: Case, packed: Packed, w: float = 0.0):
         n = case.n_dof
         K = case.model.K
         fixed, ybase = _support(case)
@@ -130,20 +130,9 @@ class _State:
         self.Dref = np.zeros(packed.n_parts)
         init_states(packed.laws, self.q, self.v, self.S, self.D, self.Dref)
         self.fnl = np.zeros(n)
-        self.a = np.zeros(n)
-        self.rebalance(case, packed, F, w)
-
-    def rebalance(self, case: Case, packed: Packed, F: np.ndarray, w: float) -> None:
-        """Element forces from the states and the acceleration that balances the equations
-        at phase 0 (load ``F``), for the present ``q``, ``v``, ``S``."""
-        M, C, K = case.model.M, case.model.C, case.model.K
-        fixed, ybase = _support(case)
-        fx = np.flatnonzero(fixed)
-        fr = np.flatnonzero(fixed == 0)
         element_forces(packed.laws, self.S, self.fnl)
-        self.a[fx] = -w * w * ybase[fx]
-        rhs = F - C @ self.v - K @ self.q - self.fnl - M[:, fx] @ self.a[fx]
-        self.a[fr] = np.linalg.solve(M[np.ix_(fr, fr)], rhs[fr])
+        # the acceleration that balances the equations at phase 0
+        self.a = Balance(kernel_model(case), packed.laws, w).acceleration(self.q, self.v, self.S)
 
     def arrays(self) -> tuple:
         """``(q, v, a, fnl, S, D, Dref)``, the kernels' state tuple (updated in place)."""
@@ -353,7 +342,7 @@ def steady_state(case: Case, freq_hz: float, options: TimeSimOptions | None = No
     opts.validate()
     f = _check_freq(freq_hz)
     _check_supported(case)
-    state = _State(case, pack_elements(case.elements, case.n_dof), case.excitation.force, 2 * np.pi * f)
+    state = _State(case, pack_elements(case.elements, case.n_dof), 2 * np.pi * f)
     return _settle(case, f, opts, opts.steps, state, progress)
 
 
@@ -375,7 +364,7 @@ def transient(case: Case, freq_hz: float, periods: int, switch_off_at: float | N
     if switch_off_at is not None and not (switch_off_at >= 0 and math.isfinite(switch_off_at)):
         raise CaseError(f"switch-off time must be >= 0 s, got {switch_off_at!r}")
     _check_supported(case, switch_off_at)
-    state = _State(case, pack_elements(case.elements, case.n_dof), case.excitation.force, 2 * np.pi * f)
+    state = _State(case, pack_elements(case.elements, case.n_dof), 2 * np.pi * f)
     return _integrate(case, f, opts, opts.steps, int(periods), False, switch_off_at, state, progress)
 
 
@@ -415,7 +404,7 @@ def timesim(case: Case, freq_hz: float, options: TimeSimOptions | None = None,
     t0 = time.perf_counter()
     if periods is None:
         packed = pack_elements(case.elements, case.n_dof)
-        state = _State(case, packed, case.excitation.force, 2 * np.pi * f)
+        state = _State(case, packed, 2 * np.pi * f)
         coarse = _settle(case, f, opts, opts.steps, state, progress)
         fine = _settle(case, f, opts, 2 * opts.steps, state, progress, period_offset=coarse.periods)
         mode, conv, total = "steady", coarse.converged and fine.converged, coarse.periods + fine.periods
