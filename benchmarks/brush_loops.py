@@ -40,7 +40,6 @@ def main(argv=None):
     st = br.static_state()
     print(f"brush: {st['bristles_loaded']} of {st['bristles']} bristles loaded, approach {st['approach'] / UM:.3f} um, "
           f"kn {br.kn:.4g} N/m, kt {br.kt:.4g} N/m per bristle")
-    th = 2 * np.pi * np.arange(N_SAMPLES) / N_SAMPLES
     summary = {"static": st}
     t0 = time.perf_counter()
 

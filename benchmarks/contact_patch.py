@@ -92,10 +92,7 @@ def measure(n_c: int, H: int, max_points: int) -> dict:
     X = problem.linear_solution(w, problem.stuck_stiffness())
     problem.residual(X, w)                                   # compile
 
-    def linear():
-        problem._memo_w = None
-        problem._linear(w)
-    lin = _best(linear)
+    lin = _best(lambda: problem.linear._builder(w))
     d = problem.nl.dofs
     aft = _best(lambda: problem.nl.evaluate(np.ascontiguousarray(X[:, d]), w))
     R, J, _ = problem.residual(X, w)

@@ -129,7 +129,6 @@ def curve_error(res, ref, name):
 def time_domain_cost(case, f_peak, a_ref, name, ladder):
     """Per-frequency timesim cost and peak error at each steps-per-period of the ladder."""
     from hbm.timesim import TimeSimOptions, steady_state
-    g = case.analysis.outputs[name]
     out = []
     for steps in ladder:
         opts = TimeSimOptions(steps=steps, tol=1e-9, max_periods=20000)

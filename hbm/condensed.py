@@ -38,86 +38,36 @@ the same check as the full model's (there ``-W[R, \dot X]``).
 """
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 
 from .aft import NonlinearForces
-from .energy import EnergyBalance
-from .fourier import FourierBasis
-from .modal_hill import ModalData
 from .condensed_kernels import assemble
 from .condensed_linear import LinearBuilder, LinearPart
+from .contact_coordinates import contact_coordinates, regathered
+from .fourier import FourierBasis
+from .modal_hill import ModalData
 from .reduction import ReducedModel, condense
-
-_RANK_TOL = 1e-10
-
-
-def contact_coordinates(elements, n_dof: int):
-    """Independent contact rows ``G_c`` and each element's rows on them, ``A_e``.
-
-    Rows are taken from the elements' gather matrices in order, skipping any row in the span
-    of those already taken, so the coordinates are the elements' own (relative) coordinates
-    when these are independent.
-
-    Parameters
-    ----------
-    elements : sequence of Element
-        Gather matrices of shape (n_local, n_dof).
-    n_dof : int
-
-    Returns
-    -------
-    G_c : ndarray, shape (n_c, n_dof)
-    A : list of ndarray
-        ``A_e`` (n_local, n_c) with ``gather_e = A_e G_c``.
-    """
-    rows = np.vstack([e.gather for e in elements])
-    if rows.shape[1] != n_dof:
-        raise ValueError(f"element gather has {rows.shape[1]} columns, the model has {n_dof} DOFs")
-    cols = np.flatnonzero(np.any(rows != 0.0, axis=0))
-    S = rows[:, cols]
-    chosen, Q = [], np.zeros((0, cols.size))
-    for i, s in enumerate(S):
-        v = s - Q.T @ (Q @ s)
-        v = v - Q.T @ (Q @ v)
-        nv = np.linalg.norm(v)
-        if nv > _RANK_TOL * max(np.linalg.norm(s), 1e-300):
-            chosen.append(i)
-            Q = np.vstack([Q, v / nv])
-    G_c = rows[chosen]
-    P = np.linalg.pinv(G_c[:, cols])
-    A = []
-    for e in elements:
-        Ae = e.gather[:, cols] @ P
-        err = np.abs(Ae @ G_c[:, cols] - e.gather[:, cols]).max(initial=0.0)
-        if err > 1e-9 * max(np.abs(e.gather).max(), 1e-300):
-            raise ValueError(f"element {e.name}: its coordinates are not spanned by the contact rows")
-        A.append(Ae)
-    return G_c, A
+from .residual import HarmonicBalance
 
 
-def _regathered(element, A):
-    """A copy of ``element`` reading its coordinates from the contact coordinates: gather ``A``."""
-    e = copy.copy(element)
-    G = np.array(A, dtype=float)
-    G[np.abs(G) < 1e-14 * max(np.abs(G).max(initial=0.0), 1e-300)] = 0.0
-    G.setflags(write=False)
-    e.gather = G
-    return e
+def condensed_balance(reduced: ReducedModel, elements, basis: FourierBasis, force, transform,
+                      output_rows=None, linear_strategy: str = "auto") -> HarmonicBalance:
+    """The harmonic balance of ``reduced`` with ``elements`` on their contact coordinates
+    (:class:`CondensedLinear`'s parameters)."""
+    linear = CondensedLinear(reduced, elements, basis, force, output_rows, linear_strategy)
+    return HarmonicBalance(linear, NonlinearForces(basis, linear.elements, linear.n_dof, transform))
 
 
-class CondensedHarmonicBalance:
-    """Residual ``R(U, w)`` on the contact coordinates (module docstring); the interface of
-    :class:`hbm.residual.HarmonicBalance` used by :mod:`hbm.response` and :mod:`hbm.energy`.
+class CondensedLinear:
+    """``Z_c(w)``, ``F_eq(w)`` and what the analyses ask of a reduced model, on the contact
+    coordinates (module docstring).
 
     The linear part at a frequency, ``Z_c`` and ``h dZ_c/dW`` per harmonic with the equivalent
     load, comes from :class:`hbm.condensed_linear.LinearBuilder` (few contacts: one compiled
-    call; many: the Woodbury form on quantities factored once); one compiled call then writes
-    ``Z_c`` into the Jacobian beside the AFT's, so no ``n_u x n_u`` matrix of the linear part
-    is ever formed.  The linear part is memoised
-    for the last ``w`` and the nonlinear forces for the last residual evaluation (exact ``X``
-    and ``w`` only: re-used, they are the same numbers).
+    call; many: the Woodbury form on quantities factored once); one compiled call then adds
+    ``Z_c`` to the Jacobian beside the AFT's, so no ``n_u x n_u`` matrix of the linear part is
+    ever formed.  :meth:`at` keeps the last frequency's parts (Newton at a fixed frequency
+    asks for them again; the same numbers either way).
 
     Parameters
     ----------
@@ -127,10 +77,8 @@ class CondensedHarmonicBalance:
         Gather matrices over the full model, (n_local, n_dof).
     basis : FourierBasis
         Must contain harmonic 1.
-    force : ndarray, shape (n_dof,)
-        Cosine excitation at the first harmonic (N per DOF).
-    transform : object
-        AFT transform built on ``basis``.
+    force : ndarray, shape (n_dof,) or (2, n_dof)
+        Cosine (and sine) excitation at the first harmonic (N per DOF).
     output_rows : ndarray, shape (n_o, n_dof), optional
         Output coordinates ``y = G_o q`` (default: the force's direction).
     linear_strategy : str
@@ -142,12 +90,12 @@ class CondensedHarmonicBalance:
     n_dof : int
         Number of contact coordinates ``n_c`` (the unknowns per coefficient).
     contact_rows : ndarray, shape (n_c, n_dof)
+    elements : list of Element
+        The elements reading the contact coordinates (gather ``A_e``).
     condensed : CondensedModel
-    nl : NonlinearForces
-        On the contact coordinates.
     """
 
-    def __init__(self, reduced: ReducedModel, elements, basis: FourierBasis, force, transform,
+    def __init__(self, reduced: ReducedModel, elements, basis: FourierBasis, force,
                  output_rows=None, linear_strategy: str = "auto"):
         if 1 not in basis.harmonics:
             raise ValueError("the harmonic list must contain harmonic 1 (the excitation's)")
@@ -158,7 +106,7 @@ class CondensedHarmonicBalance:
         G_e = force[:1] if force.shape[0] == 1 or not np.any(force[1]) else force
         if elements:
             G_c, A = contact_coordinates(elements, n)
-            elems = [_regathered(e, a) for e, a in zip(elements, A)]
+            elems = [regathered(e, a) for e, a in zip(elements, A)]
         else:   # linear structure: any coordinate will do, take the excitation's
             G_c, elems = G_e, []
         G_o = G_e if output_rows is None else np.atleast_2d(np.asarray(output_rows, dtype=float))
@@ -169,7 +117,7 @@ class CondensedHarmonicBalance:
         self.condensed = cm = condense(reduced, G_c, G_o, G_e)
         nc = G_c.shape[0]
         self.n_dof = nc
-        self.nl = NonlinearForces(basis, elems, nc, transform)
+        self.elements = elems
         nco = basis.n_coef
         F_e = np.zeros((nco, G_e.shape[0]))      # unit cosine on the first row, unit sine on the second
         F_e[basis.row_of(1, "c"), 0] = 1.0
@@ -205,13 +153,7 @@ class CondensedHarmonicBalance:
         self._builder = LinearBuilder(reduced, self._phi_all, self._R_all, nc, ne, self._h, self._rc, self._i1,
                                       linear_strategy, self._Fe_c[self._i1])
         self._ge = self._Fe_c @ self._phi["e"]          # Phi^T G_e^T F_e per harmonic, (n_h, m)
-        d = self.nl.dofs
-        self._nl_all = d.size == nc
-        idx = (np.arange(nco)[:, None] * nc + d[None, :]).ravel()
-        self._nl_ix = np.ix_(idx, idx)
-        self._memo_w = None
-        self._memo = None
-        self._last_nl = None
+        self._last = (None, None)
 
     @property
     def n_unknowns(self) -> int:
@@ -245,125 +187,40 @@ class CondensedHarmonicBalance:
         return (self._to_r @ Y).real
 
     # ------------------------------------------------------------------ linear part
-    def _linear(self, w: float) -> LinearPart:
-        """The linear part at ``w`` (:class:`hbm.condensed_linear.LinearPart`).
-
-        Memoised for the last ``w`` only (Newton at a fixed frequency re-uses it).
-        """
+    def at(self, w: float) -> LinearPart:
+        """The linear part at ``w`` (:class:`hbm.condensed_linear.LinearPart`); the last
+        frequency's is kept."""
         w = float(w)
-        if self._memo_w != w:
-            self._memo = self._builder(w)
-            self._memo_w = w
-        return self._memo
+        if self._last[0] != w:
+            self._last = (w, self._builder(w))
+        return self._last[1]
 
     def load(self, w: float) -> np.ndarray:
         """Equivalent contact load ``F_eq(w)`` (n_coef, n_c)."""
-        return self._linear(w).F.reshape(self.basis.n_coef, self.n_dof).copy()
+        return self.at(w).F.reshape(self.basis.n_coef, self.n_dof).copy()
 
     # ------------------------------------------------------------------ residual
-    def residual(self, X: np.ndarray, w: float):
-        """Residual and Jacobians.
+    def assemble(self, X, w, Fn, dFw, J, R, dRw):
+        """``R = Z_c U - F_eq + F_nl`` and ``dR/dw`` written, ``Z_c`` added to ``J`` (which
+        holds ``dF_nl/dU`` on entry).
 
         Parameters
         ----------
-        X : ndarray, shape (n_coef, n_c)
+        X, Fn, dFw : ndarray, shape (n_coef, n_c)
+            Contact coefficients, nonlinear forces and their ``w``-derivative.
         w : float
-
-        Returns
-        -------
-        R : ndarray, shape (n_u,)
-        dRdX : ndarray, shape (n_u, n_u)
-        dRdw : ndarray, shape (n_u,)
+        J : ndarray, shape (n_u, n_u)
+        R, dRw : ndarray, shape (n_u,)
         """
-        nu = self.n_unknowns
-        J, dRw = np.empty((nu, nu)), np.empty(nu)
-        R = self._evaluate(X, w, J, dRw)
-        return R, J, dRw
+        L = self.at(w)
+        assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, np.ascontiguousarray(X.reshape(-1), dtype=float),
+                 np.ascontiguousarray(Fn.reshape(-1)), np.ascontiguousarray(dFw.reshape(-1)), J, R, dRw)
 
-    def __call__(self, x: np.ndarray):
-        """Continuation form: ``x = [U.ravel(), w]`` -> ``R`` (n_u,), ``[dR/dU, dR/dw]``
-        (n_u, n_u + 1), new arrays on every call."""
-        nu = self.n_unknowns
-        A = np.empty((nu, nu + 1))
-        R = self._evaluate(x[:-1].reshape(self.basis.n_coef, self.n_dof), float(x[-1]), A[:, :nu], A[:, nu])
-        return R, A
-
-    def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray, dRw: np.ndarray) -> np.ndarray:
-        """``R`` (n_u,) returned; ``dR/dU`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw`` (n_u,)."""
-        L = self._linear(w)
-        x = np.ascontiguousarray(X.reshape(-1), dtype=float)
-        nu = x.size
-        if not self.nl.n_nl:
-            z = np.zeros(nu)
-            J[...] = 0.0
-            R = np.empty(nu)
-            assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, x, z, z, J, R, dRw)
-            return R
-        d = self.nl.dofs
-        Xn = np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float)
-        if self._nl_all:                             # the AFT writes dF/dU straight into J
-            Fn, _, dFw = self.nl.evaluate(Xn, w, J_out=J)
-        else:
-            Fn, dFn, dFw = self.nl.evaluate(Xn, w)
-            if self._nl_all:
-                J[...] = dFn
-            else:                                    # scatter onto every contact coordinate
-                J[...] = 0.0
-                J[self._nl_ix] = dFn
-        self._last_nl = (float(w), np.array(X, dtype=float), Fn)
-        if not self._nl_all:
-            nco, n = X.shape
-            Fa, dFa = np.zeros((nco, n)), np.zeros((nco, n))
-            Fa[:, d], dFa[:, d] = Fn, dFw
-            Fn, dFw = Fa, dFa
-        R = np.empty(nu)
-        assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, x, np.ascontiguousarray(Fn.reshape(-1)),
-                 np.ascontiguousarray(dFw.reshape(-1)), J, R, dRw)
-        return R
-
-    def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
-        """``F_nl`` on the contact coordinates, (n_coef, n_c).
-
-        Re-uses the forces of the last residual evaluation when ``X`` and ``w`` are exactly
-        its own (then they are the same numbers); otherwise runs the AFT (forces only).
-        """
-        if not self.nl.n_nl:
-            return np.zeros_like(X, dtype=float)
-        d = self.nl.dofs
-        last = self._last_nl
-        if last is not None and last[0] == float(w) and last[1].shape == X.shape and bool((last[1] == X).all()):
-            Fn = last[2].copy()
-        else:
-            Fn = self.nl.forces(np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float), w)
-        if self._nl_all:
-            return Fn
-        F = np.zeros_like(X, dtype=float)
-        F[:, d] = Fn
-        return F
-
-    def nonlinear_jacobian(self, X: np.ndarray, w: float, nl=None):
-        """``dF_nl/dU`` on every contact coordinate, (n_coef n_c, n_coef n_c), or ``None``
-        without elements.
-
-        ``nl`` : the elements' :class:`~hbm.aft.NonlinearForces` on another basis (``X`` then
-        has that basis' rows); default the problem's own."""
-        nl = self.nl if nl is None else nl
-        if not nl.n_nl:
-            return None
-        d = nl.dofs
-        _, dFn, _ = nl.evaluate(np.ascontiguousarray(X if self._nl_all else X[:, d], dtype=float), w)
-        if self._nl_all:
-            return dFn
-        nco, nc = nl.basis.n_coef, self.n_dof
-        idx = (np.arange(nco)[:, None] * nc + d[None, :]).ravel()
-        Ja = np.zeros((nco * nc, nco * nc))
-        Ja[np.ix_(idx, idx)] = dFn
-        return Ja
-
-    def modal_data(self) -> ModalData:
-        """The kept modes and residual flexibility on the contact coordinates (:mod:`hbm.modal_hill`)."""
-        c = self._sl["c"]
-        return ModalData(self.reduced.omega, self._phi["c"], self._R_all[c, c], self.reduced.modal_c)
+    def modal_data(self, rows: np.ndarray) -> ModalData:
+        """The kept modes and residual flexibility seen from the contact coordinates ``rows``
+        (:mod:`hbm.modal_hill`)."""
+        Rcc = self._R_all[self._sl["c"], self._sl["c"]]
+        return ModalData(self.reduced.omega, self._phi["c"][rows], Rcc[np.ix_(rows, rows)], self.reduced.modal_c)
 
     def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
         """Solution of ``(Z_c(w) + K_extra) U = F_eq(w)`` (n_coef, n_c): the start of Newton.
@@ -371,7 +228,7 @@ class CondensedHarmonicBalance:
         ``extra_stiffness`` (n_c, n_c) adds e.g. the stuck stiffness of the elements.
         Per harmonic in complex form (a real ``K_extra`` adds to the real part of ``Z_c``).
         """
-        L = self._linear(w)
+        L = self.at(w)
         Z = L.Z if extra_stiffness is None else L.Z + np.asarray(extra_stiffness, dtype=float)
         f = self._complex(L.F.reshape(self.basis.n_coef, self.n_dof))
         u = np.zeros_like(f)
@@ -379,27 +236,16 @@ class CondensedHarmonicBalance:
             u[i] = np.linalg.solve(Z[i], f[i])
         return self._real(u)
 
-    def stuck_stiffness(self) -> np.ndarray:
-        """Tangent stiffness of the elements at rest on the contact coordinates, (n_c, n_c)."""
-        K = np.zeros((self.n_dof, self.n_dof))
-        for e in self.nl.elements:
-            K += e.gather.T @ e.linear_stiffness() @ e.gather
-        return K
+    def linear_peak_amplitudes(self, ws, Ks, Cs=None):
+        """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear
+        responses (stuck: ``Z_c + Ks``, (n_c, n_c)).
 
-    def modal_rows(self) -> np.ndarray:
-        """The contact coordinates that :meth:`modal_data`'s ``phi_c`` rows stand for: all."""
-        return np.arange(self.n_dof)
-
-    def linear_peak_amplitudes(self, ws, stuck_stiffness=None, stuck_damping=None):
-        """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear responses.
-
-        ``stuck_damping`` is not used (the stuck limit adds the stiffness only).
+        ``Cs`` is not used (the stuck limit adds the stiffness only).
 
         Returns
         -------
         free, stuck : ndarray, shape (n_c,)
         """
-        Ks = self.stuck_stiffness() if stuck_stiffness is None else stuck_stiffness
         ws = np.atleast_1d(np.asarray(ws, dtype=float))
         nc = self.n_dof
         free, stuck = np.zeros(nc), np.zeros(nc)
@@ -433,11 +279,12 @@ class CondensedHarmonicBalance:
         """Output coefficients ``Y = H_oe F_e - H_oc F'`` (n_coef, n_o) from the contact
         coefficients ``X`` (n_coef, n_c); equal to ``T_oc U + T_oe F_e`` of
         :meth:`hbm.reduction.CondensedModel.recover_outputs`."""
-        L = self._linear(w)
+        L = self.at(w)
         return self._respond("o", self._implied_forces(X, L), L)
 
-    def energy_balance(self, X: np.ndarray, w: float) -> EnergyBalance:
-        """Work per period of the excitation, the viscous and the nonlinear forces (module doc).
+    def work(self, X: np.ndarray, w: float, Fn=None):
+        """Excitation and viscous work per period and the bound ``S`` (module doc,
+        :mod:`hbm.energy`); the nonlinear forces ``Fn`` are not needed here.
 
         In complex form per harmonic (``X_h = Xc - i Xs``, velocity ``i h w X_h``), the work of
         ``F`` on the motion ``Y`` over a period is ``-pi sum_h h Im(conj(F_h) Y_h)``; for the unit
@@ -445,9 +292,8 @@ class CondensedHarmonicBalance:
         coordinate's harmonic-1 amplitude (with a sine row, ``-pi Im(conj(F_e) . y_e)``).
         """
         r = self.reduced
-        L = self._linear(w)
+        L = self.at(w)
         fp = self._implied_forces(X, L)
-        w_nl = np.pi * float(np.vdot(self.nonlinear_forces(X, w), self.basis.D @ X))
         i1, nc = self._i1, self.n_dof
         ne = self._Fe_c.shape[1]
         fe = self._Fe_c[i1]
@@ -467,4 +313,4 @@ class CondensedHarmonicBalance:
             eta = np.linalg.solve(D, g[:, :, None])[:, :, 0]
         v = iW * eta
         w_v = float(np.vdot(v, v @ Cm.T).real)
-        return EnergyBalance(w_ex, np.pi / w * w_v, w_nl, np.pi * float(np.linalg.norm(fe) * np.linalg.norm(ye)))
+        return w_ex, np.pi / w * w_v, np.pi * float(np.linalg.norm(fe) * np.linalg.norm(ye))

@@ -1,13 +1,14 @@
 r"""Residual and Jacobian of a small dense harmonic-balance model in one compiled call.
 
-With the three matrices of :class:`hbm.residual.HarmonicBalance` stored once
-(:math:`Z(w) = Z_0 + w Z_1 - w^2 Z_2`, harmonic-major unknowns ``x``):
+With the three matrices of :class:`hbm.dense_part.DenseLinear` stored once
+(:math:`Z(w) = Z_0 + w Z_1 - w^2 Z_2` on the unknowns ``x``, harmonic-major) and the load
+``F(w)`` with its derivative:
 
 .. math::
 
-    R = Z(w)\, x - F_{ex} + F_{nl}, \qquad
+    R = Z(w)\, x - F + F_{nl}, \qquad
     \frac{\partial R}{\partial x} = Z(w) + \frac{\partial F_{nl}}{\partial x}, \qquad
-    \frac{\partial R}{\partial w} = (Z_1 - 2 w Z_2)\, x + \frac{\partial F_{nl}}{\partial w},
+    \frac{\partial R}{\partial w} = (Z_1 - 2 w Z_2)\, x - F' + \frac{\partial F_{nl}}{\partial w},
 
 in one pass over the matrices instead of a dozen NumPy calls (each a few microseconds, a
 large part of a small model's Newton iteration).
@@ -18,8 +19,9 @@ import numba as nb
 
 
 @nb.njit(cache=True)
-def dense_residual(Z0, Z1, Z2, w, x, Fex, Fn, dFn, dFw, J, R, dRw):
-    """Write ``R`` (n_u,), ``J = dR/dx`` (n_u, n_u) and ``dRw = dR/dw`` (n_u,) (module doc).
+def dense_residual(Z0, Z1, Z2, w, x, F, dF, Fn, dFw, J, R, dRw):
+    """Write ``R`` (n_u,) and ``dRw = dR/dw`` (n_u,) and add ``Z(w)`` to ``J`` (n_u, n_u), which
+    holds ``dF_nl/dx`` on entry (module doc).
 
     Parameters
     ----------
@@ -28,11 +30,11 @@ def dense_residual(Z0, Z1, Z2, w, x, Fex, Fn, dFn, dFw, J, R, dRw):
     w : float
         Fundamental angular frequency.
     x : ndarray, shape (n_u,)
-        Unknowns (all DOFs free).
-    Fex, Fn, dFw : ndarray, shape (n_u,)
-        Excitation, nonlinear forces and their ``w``-derivative on all unknowns.
-    dFn : ndarray, shape (n_u, n_u)
-        Jacobian of the nonlinear forces.
+        Unknowns.
+    F, dF : ndarray, shape (n_u,)
+        Load and its ``w``-derivative.
+    Fn, dFw : ndarray, shape (n_u,)
+        Nonlinear forces and their ``w``-derivative on the unknowns.
     J : ndarray, shape (n_u, n_u)
     R, dRw : ndarray, shape (n_u,)
         Outputs (views allowed).
@@ -47,6 +49,6 @@ def dense_residual(Z0, Z1, Z2, w, x, Fex, Fn, dFn, dFw, J, R, dRw):
             xj = x[j]
             r += z * xj
             dr += (Z1[i, j] - 2.0 * w * Z2[i, j]) * xj
-            J[i, j] = z + dFn[i, j]
-        R[i] = (r - Fex[i]) + Fn[i]
-        dRw[i] = dr + dFw[i]
+            J[i, j] += z
+        R[i] = (r - F[i]) + Fn[i]
+        dRw[i] = (dr - dF[i]) + dFw[i]

@@ -18,9 +18,10 @@ could do at this motion (Cauchy-Schwarz).  Without the floor a point that dissip
 (an undamped structure with its contacts stuck: every work is zero up to round-off) had a
 "relative error" of 1 and was refused; with it, such a point passes when its imbalance is
 at round-off level against ``S``, and a dissipating point is judged as before.
-A problem that carries its own balance (the condensed problem of
-:mod:`hbm.condensed`, whose viscous work comes from modal coordinates) provides
-``problem.energy_balance(X, w)``, which :func:`energy_balance` uses.
+The linear part supplies the excitation and viscous work (:meth:`work` of
+:class:`hbm.dense_part.DenseLinear` and :class:`hbm.condensed.CondensedLinear`, the latter
+from modal coordinates); :meth:`hbm.residual.HarmonicBalance.energy_balance` adds the
+nonlinear forces' work.
 """
 from __future__ import annotations
 
@@ -59,20 +60,4 @@ def work(basis, F: np.ndarray, V: np.ndarray, w: float) -> float:
 
 def energy_balance(problem, X: np.ndarray, w: float) -> EnergyBalance:
     """Energy balance of ``problem`` (a :class:`hbm.residual.HarmonicBalance`) at ``(X, w)``."""
-    own = getattr(problem, "energy_balance", None)
-    if own is not None:
-        return own(X, w)
-    basis = problem.basis
-    s = 1 if basis.has_zero else 0          # the mean does no work
-    V = w * (basis.D @ X)
-    Vp = V[s:]
-
-    def on_v(F):                            # work() on the velocities of every DOF
-        return float(np.pi / w * np.vdot(F[s:], Vp))
-    w_ex = on_v(problem.Fex)
-    bound = np.pi / w * float(np.linalg.norm(problem.Fex[s:]) * np.linalg.norm(Vp))
-    if problem.fixed.size:
-        Rb = problem.support_reactions(X, w)
-        w_ex += work(basis, Rb, V[:, problem.fixed], w)
-        bound += np.pi / w * float(np.linalg.norm(Rb[s:]) * np.linalg.norm(V[s:, problem.fixed]))
-    return EnergyBalance(w_ex, on_v(V @ problem.model.C), on_v(problem.nonlinear_forces(X, w)), bound)
+    return problem.energy_balance(X, w)

@@ -183,8 +183,9 @@ def harmonic_blocks(model: LinearModel, basis: FourierBasis, w: float):
     return blocks, dblocks
 
 
-def fill_dynamic_stiffness(Z: np.ndarray, K, C, M, basis: FourierBasis, w: float) -> np.ndarray:
-    r"""Write the dense harmonic-balance dynamic stiffness ``Z(w)`` into ``Z`` and return it.
+def fill_dynamic_stiffness(Z: np.ndarray, K, C, M, basis: FourierBasis, w: float, add: bool = False) -> np.ndarray:
+    r"""Write (or with ``add``, add) the dense harmonic-balance dynamic stiffness ``Z(w)`` into ``Z``
+    and return it.
 
     Per coefficient row ``r`` of harmonic ``h_r``: ``K - (h_r w)^2 M`` on the diagonal block and
     ``\pm h w C`` between the cosine and sine rows of ``h`` (the derivative operator), so that
@@ -193,7 +194,8 @@ def fill_dynamic_stiffness(Z: np.ndarray, K, C, M, basis: FourierBasis, w: float
     Parameters
     ----------
     Z : ndarray, shape (n_coef n, n_coef n)
-        Zeroed on entry (or holding only entries outside the blocks written here).
+        Zeroed on entry (or holding only entries outside the blocks written here); any
+        strides (e.g. the first columns of a bordered matrix).
     K, C, M : ndarray, shape (n, n)
     basis : FourierBasis
     w : float
@@ -205,12 +207,18 @@ def fill_dynamic_stiffness(Z: np.ndarray, K, C, M, basis: FourierBasis, w: float
     """
     nc, n = basis.n_coef, K.shape[0]
     h = basis.h_of_row
-    Z4 = Z.reshape(nc, n, nc, n)
+    s0, s1 = Z.strides
+    Z4 = np.lib.stride_tricks.as_strided(Z, (nc, n, nc, n), (n * s0, s0, n * s1, s1))
     r = np.arange(nc)
-    Z4[r, :, r, :] = K[None] - (w * w) * (h * h).astype(float)[:, None, None] * M[None]
+    diag = K[None] - (w * w) * (h * h).astype(float)[:, None, None] * M[None]
     rc = np.flatnonzero(h > 0)[::2]
-    if rc.size:
-        wC = (w * h[rc]).astype(float)[:, None, None] * C[None]
+    wC = (w * h[rc]).astype(float)[:, None, None] * C[None]
+    if add:
+        Z4[r, :, r, :] += diag
+        Z4[rc, :, rc + 1, :] += wC
+        Z4[rc + 1, :, rc, :] -= wC
+    else:
+        Z4[r, :, r, :] = diag
         Z4[rc, :, rc + 1, :] = wC
         Z4[rc + 1, :, rc, :] = -wC
     return Z

@@ -12,12 +12,12 @@ import numpy as np
 
 from .budget import check_memory
 from .case import Case, CaseError
-from .condensed import CondensedHarmonicBalance
+from .condensed import condensed_balance
+from .dense_part import dense_balance
 from .fourier import FourierBasis, default_samples, max_abs, min_samples, parse_harmonics
 from .mode_cover import reduce_covering
 from .newton import newton
 from .reduction_cache import cache_path
-from .residual import HarmonicBalance
 from .structure import AUTO_CONDENSE_DOF
 from .transforms import fftw_available, make_transform
 
@@ -99,7 +99,8 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
 
     Returns
     -------
-    problem : HarmonicBalance or CondensedHarmonicBalance
+    problem : HarmonicBalance
+        On a dense or a condensed linear part.
     info : dict
         ``solver``, ``n_dof`` (model), ``n_unknowns``, and for the condensed solver ``modes``,
         ``residual_flexibility``, ``contact_coordinates``, ``reduction_seconds``,
@@ -111,8 +112,8 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
     st = case.structure
     info = {"solver": solver, "n_dof": st.n_dof}
     if solver == "full":
-        problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.cos_sin, tr,
-                                  base=case.excitation.base, output_rows=case.analysis.output_rows(st.n_dof))
+        problem = dense_balance(case.model, case.elements, basis, case.excitation.cos_sin, tr,
+                                base=case.excitation.base, output_rows=case.analysis.output_rows(st.n_dof))
         info.update(modes=None, reduction_seconds=0.0)
     elif case.excitation.base is not None:
         raise CaseError(f"{case.path}: [excitation] base (support motion) needs the full solver: "
@@ -126,7 +127,7 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
         try:
             cr, cover = reduce_covering(st, keep, modes, case.reduction.residual_flexibility, cache_path(case.path),
                                         fmax_hz, basis.harmonics)
-            problem = CondensedHarmonicBalance(cr.reduced, case.elements, basis, force, tr, G_o)
+            problem = condensed_balance(cr.reduced, case.elements, basis, force, tr, G_o)
         except ValueError as exc:
             raise CaseError(f"{case.path}: [model] condensed solver: {exc}") from exc
         info.update(**cover, residual_flexibility=case.reduction.residual_flexibility,
@@ -136,28 +137,10 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
     return problem, info
 
 
-def _stuck_stiffness(problem) -> np.ndarray:
-    """Stiffness of the elements at rest over the problem's unknowns, (n, n)."""
-    K = np.zeros((problem.n_dof, problem.n_dof))
-    for e in problem.nl.elements:
-        K += e.gather.T @ e.linear_stiffness() @ e.gather
-    return K
-
-
 def recover_outputs(problem, case: Case, X: np.ndarray, w: float) -> np.ndarray:
     """Output coefficients (n_coef, n_outputs) of a point ``X`` (n_coef, n) at ``w``
     (``problem.recover_outputs``: the problem was built with ``case``'s outputs)."""
     return problem.recover_outputs(X, w)
-
-
-def _stuck_damping(problem) -> np.ndarray:
-    """Viscous tangent at rest of velocity-dependent elements (``linear_damping``), (n, n)."""
-    C = np.zeros((problem.n_dof, problem.n_dof))
-    for e in problem.nl.elements:
-        cd = getattr(e, "linear_damping", None)
-        if cd is not None:
-            C += e.gather.T @ cd() @ e.gather
-    return C
 
 
 def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
@@ -168,7 +151,7 @@ def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
     The linear responses include the supports' imposed motion (base excitation).
     """
     ws = np.linspace(w_lo, w_hi, 41)
-    amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, _stuck_stiffness(problem), _stuck_damping(problem))
+    amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, problem.stuck_stiffness(), problem.stuck_damping())
     # a DOF that only the elements couple to the force (free response nil) takes its stuck
     # amplitude, and one without any linear response (round-off) the largest scale: a
     # geometric mean with nil or the 1e-6 floor inflates it in the arclength (the path creeps)
@@ -189,7 +172,7 @@ def _first_point(problem, case, w0, scale, r_scale):
     to ``lam = 1``.
     """
     fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
-    guesses = [problem.linear_solution(w0, _stuck_stiffness(problem)), problem.linear_solution(w0)]
+    guesses = [problem.linear_solution(w0, problem.stuck_stiffness()), problem.linear_solution(w0)]
     last = None
     for g in guesses:
         res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale)

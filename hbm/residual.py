@@ -1,154 +1,87 @@
-r"""Harmonic-balance residual and its exact Jacobian, composed from its parts.
+r"""Harmonic-balance residual and its exact Jacobian: one formula, one AFT call, any linear part.
 
 .. math::
 
-    R(X, w) = Z(w) X + F_{nl}(X, w) - F_{ex}, \qquad
+    R(X, w) = Z(w) X + F_{nl}(X, w) - F(w), \qquad
     \frac{\partial R}{\partial X} = Z(w) + \frac{\partial F_{nl}}{\partial X}, \qquad
-    \frac{\partial R}{\partial w} = Z'(w) X + \frac{\partial F_{nl}}{\partial w}
+    \frac{\partial R}{\partial w} = Z'(w) X + \frac{\partial F_{nl}}{\partial w} - F'(w)
 
-``X`` has shape (n_coef, n) (harmonic-major, :mod:`hbm.fourier`); ``Z`` is applied block by
-block per harmonic (:func:`hbm.linear.harmonic_blocks`); ``F_ex`` is a cosine force at the
-first harmonic.  The continuation works on ``x = [X[:, free].ravel(), w]``.
+on the coordinates ``X`` (n_coef, n) (harmonic-major, :mod:`hbm.fourier`) that the elements
+read.  ``F_nl`` is the AFT of the elements (:class:`hbm.aft.NonlinearForces`); everything else
+is the *linear part*, of which there are two, with the same interface:
 
-Base (support) excitation: DOFs listed as supports have prescribed coefficients
-``X_b`` (a cosine motion at the first harmonic) and are not unknowns; their rows of the
-residual are dropped.  Their motion drives the free DOFs through the coupling terms of
-``Z`` (stiffness, damping and mass that connect to the support) and through any element
-attached to them, exactly as in the full equations.
+- :class:`hbm.dense_part.DenseLinear`: the coordinates are the model's DOFs, ``Z`` is built
+  per harmonic from ``M, C, K`` and ``F = F_ex`` (supports with imposed motion add a load and
+  drop their rows);
+- :class:`hbm.condensed.CondensedLinear`: the coordinates are the contact coordinates of a
+  reduced model, ``Z = H_cc^{-1}`` from kept modes and residual flexibility and
+  ``F = Z H_ce F_e`` (exact condensation).
+
+A linear part offers ``basis``, ``n_dof``, ``free``, ``fixed``, ``n_unknowns``, ``expand``,
+``unknowns``, ``assemble`` (adds ``Z``, writes ``R`` and ``dR/dw`` given the nonlinear forces),
+``load``, ``work`` (excitation and viscous work per period), ``recover_outputs``,
+``linear_solution``, ``linear_peak_amplitudes`` and ``modal_data`` (Hill's matrices).  The
+continuation works on ``x = [unknowns, w]``.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .aft import NonlinearForces
-from .dense_kernels import dense_residual
-from .fourier import FourierBasis
-from .linear import LinearModel, fill_dynamic_stiffness, harmonic_blocks
-from .modal_hill import ModalData, modal_data_of
+from .energy import EnergyBalance, work
+from .modal_hill import ModalData
 
 
 class HarmonicBalance:
-    """Residual ``R(X, w)`` of a linear model with nonlinear elements and a harmonic force.
+    """Residual ``R(X, w)`` of a linear part with nonlinear elements (module docstring).
 
     Parameters
     ----------
-    model : LinearModel
-    elements : sequence of Element
-    basis : FourierBasis
-        Must contain harmonic 1 (the excitation's).
-    force : ndarray, shape (n,) or (2, n)
-        Excitation at the first harmonic per DOF: cosine amplitudes, or rows ``[cosine, sine]``
-        (``F_c cos(w t) + F_s sin(w t)``).
-    transform : object
-        AFT transform built on ``basis``.
-    base : tuple (dofs, amplitude), optional
-        Support DOFs (k,) and the amplitudes (k,) of their imposed motion ``A cos(w t)``.
-    output_rows : ndarray, shape (n_o, n), optional
-        Output coordinates ``y = G_o q`` (:meth:`recover_outputs`; default every DOF).
+    linear : DenseLinear or CondensedLinear
+        The linear part on ``n`` coordinates.
+    nl : NonlinearForces
+        The elements on the same coordinates and basis.
     """
 
-    def __init__(self, model: LinearModel, elements, basis: FourierBasis, force, transform,
-                 base=None, output_rows=None):
-        if 1 not in basis.harmonics:
-            raise ValueError("the harmonic list must contain harmonic 1 (the excitation's)")
-        self.model = model
-        self.basis = basis
-        n = model.n_dof
-        self.output_rows = np.eye(n) if output_rows is None else np.atleast_2d(np.asarray(output_rows, dtype=float))
-        self.n_dof = n
-        self.nl = NonlinearForces(basis, elements, n, transform)
-        Fex = np.zeros((basis.n_coef, n))
-        f = np.atleast_2d(np.asarray(force, dtype=float))
-        Fex[basis.row_of(1, "c")] = f[0]
-        if f.shape[0] > 1:
-            Fex[basis.row_of(1, "s")] = f[1]
-        self.Fex = Fex
-        fixed = np.zeros(n, dtype=bool)
-        Xfix = np.zeros((basis.n_coef, n))
-        if base is not None:
-            bd, ba = base
-            fixed[np.asarray(bd, dtype=int)] = True
-            Xfix[basis.row_of(1, "c"), np.asarray(bd, dtype=int)] = np.asarray(ba, dtype=float)
-        self.fixed = np.flatnonzero(fixed)
-        self.free = np.flatnonzero(~fixed)
-        self.X_fixed = Xfix
-        self._all_free = self.fixed.size == 0
-        self._free_index = (np.arange(basis.n_coef)[:, None] * n + self.free[None, :]).ravel()
-        self._nl_all = self.nl.n_nl == n
-        # row slices of each harmonic's block in the flat unknown vector
-        self._slices = []
-        r = 0
-        for h in basis.harmonics:
-            nr = 1 if h == 0 else 2
-            self._slices.append(slice(r * n, (r + nr) * n))
-            r += nr
-        idx = (np.arange(basis.n_coef)[:, None] * n + self.nl.dofs[None, :]).ravel()
-        self._nl_index = idx
-        self._nl_free = ~np.isin(self.nl.dofs, self.fixed)
-        self._modal = None
-        h = basis.h_of_row
-        self._h2 = (h * h).astype(float)
-        # small dense models: Z(w) = Z0 + w Z1 - w^2 Z2 from three matrices built once
-        self._templates = None
-        mats = (model.K, model.C, model.M)
-        if basis.n_coef * n <= self.TEMPLATE_MAX and all(isinstance(m, np.ndarray) for m in mats):
-            nu_all, zero = basis.n_coef * n, np.zeros((n, n))
-            parts = ((model.K, zero, zero), (zero, model.C, zero), (zero, zero, -model.M))
-            self._templates = tuple(fill_dynamic_stiffness(np.zeros((nu_all, nu_all)), K, C, M, basis, 1.0)
-                                    for K, C, M in parts)
-        self._fex_flat = np.ascontiguousarray(self.Fex.reshape(-1))
-        nu_all = basis.n_coef * n
-        self._zero_forces = (np.zeros(nu_all), np.zeros((nu_all, nu_all)), np.zeros(nu_all))
+    def __init__(self, linear, nl: NonlinearForces):
+        if nl.basis is not linear.basis and list(nl.basis.harmonics) != list(linear.basis.harmonics):
+            raise ValueError("the elements' basis differs from the linear part's")
+        self.linear = linear
+        self.nl = nl
+        self.basis = linear.basis
+        self.n_dof = linear.n_dof
+        free = linear.free
+        d = nl.dofs
+        self._nl_free = np.isin(d, free)
+        # the AFT writes dF/dX straight into the Jacobian when the elements read every unknown
+        self._direct = d.size == free.size == self.n_dof and bool(np.all(d == np.arange(self.n_dof)))
+        nco, nn = self.basis.n_coef, d.size
+        k = (np.arange(nco)[:, None] * nn + np.flatnonzero(self._nl_free)[None, :]).ravel()
+        u = (np.arange(nco)[:, None] * free.size + np.searchsorted(free, d[self._nl_free])[None, :]).ravel()
+        self._k, self._u = k, u           # nonlinear Jacobian entries on free coordinates -> unknowns
 
-    TEMPLATE_MAX = 600     # largest n_coef * n_dof for which Z0, Z1, Z2 are kept (3 n^2 floats)
+    # ------------------------------------------------------------------ unknowns
+    @property
+    def free(self) -> np.ndarray:
+        return self.linear.free
+
+    @property
+    def fixed(self) -> np.ndarray:
+        return self.linear.fixed
 
     @property
     def n_unknowns(self) -> int:
-        return self.basis.n_coef * self.free.size
+        return self.linear.n_unknowns
 
     def expand(self, x: np.ndarray) -> np.ndarray:
-        """Unknown vector (n_coef * n_free,) -> full coefficients (n_coef, n) with supports."""
-        if self._all_free:
-            return x.reshape(self.basis.n_coef, self.n_dof)
-        X = self.X_fixed.copy()
-        X[:, self.free] = x.reshape(self.basis.n_coef, self.free.size)
-        return X
+        """Unknown vector (n_u,) -> coefficients of every coordinate (n_coef, n)."""
+        return self.linear.expand(x)
 
     def unknowns(self, X: np.ndarray) -> np.ndarray:
-        """Full coefficients (n_coef, n) -> unknown vector (n_coef * n_free,)."""
-        return X.reshape(-1).copy() if self._all_free else X[:, self.free].reshape(-1)
+        """Coefficients (n_coef, n) -> unknown vector (n_u,)."""
+        return self.linear.unknowns(X)
 
-    def linear_part(self, X: np.ndarray, w: float, out=None):
-        """``Z(w) X`` (n_coef, n), ``Z(w)`` dense (n_u, n_u) and ``Z'(w) X`` (n_coef, n).
-
-        ``out``, if given, is a zeroed (n_u, n_u) array (or view) that receives ``Z``.
-
-        Per coefficient row ``r`` of harmonic ``h_r``: ``(Z X)_r = K X_r + w C (D X)_r
-        - w^2 h_r^2 M X_r`` (``D`` the derivative operator), evaluated for all rows at
-        once; ``Z`` is filled harmonic block by harmonic block through a 4-D view.
-        """
-        if self._templates is not None:
-            Z0, Z1, Z2 = self._templates
-            nc, n = X.shape
-            Zw = Z0 + w * Z1 - (w * w) * Z2
-            if out is None:
-                Z = Zw
-            else:
-                Z = out
-                Z[...] = Zw
-            x = X.reshape(-1)
-            z1, z2 = Z1 @ x, Z2 @ x
-            dZX = (z1 - (2.0 * w) * z2).reshape(nc, n)
-            return (Zw @ x).reshape(nc, n), Z, dZX
-        M, C, K = self.model.M, self.model.C, self.model.K
-        h2X = self._h2[:, None] * X
-        DX = self.basis.D @ X
-        ZX = X @ K + w * (DX @ C) - (w * w) * (h2X @ M)
-        dZX = DX @ C - (2.0 * w) * (h2X @ M)
-        nc, n = X.shape
-        Z = fill_dynamic_stiffness(np.zeros((nc * n, nc * n)) if out is None else out, K, C, M, self.basis, w)
-        return ZX, Z, dZX
-
+    # ------------------------------------------------------------------ residual
     def residual(self, X: np.ndarray, w: float):
         """Residual and Jacobians.
 
@@ -160,90 +93,57 @@ class HarmonicBalance:
         Returns
         -------
         R : ndarray, shape (n_u,)
-            On the free DOFs (harmonic-major).
         dRdX : ndarray, shape (n_u, n_u)
-            With respect to the unknowns (free DOFs).
+            With respect to the unknowns.
         dRdw : ndarray, shape (n_u,)
         """
-        R, J, dRdw = self._full_residual(X, w)
-        if self._all_free:
-            return R.reshape(-1), J, dRdw.reshape(-1)
-        fi = self._free_index
-        return R.reshape(-1)[fi], J[np.ix_(fi, fi)], dRdw.reshape(-1)[fi]
-
-    def _full_residual(self, X, w, out=None):
-        """Residual (n_coef, n), Jacobian (n_c n, n_c n) and dR/dw (n_coef, n) on all DOFs."""
-        ZX, J, dZX = self.linear_part(X, w, out)
-        R = ZX - self.Fex
-        dRdw = dZX
-        if self.nl.n_nl:
-            dofs = self.nl.dofs
-            if self._nl_all:
-                F, dF, dFw = self.nl.evaluate(X, w)
-                R += F
-                dRdw += dFw
-                J += dF
-            else:
-                F, dF, dFw = self.nl.evaluate(np.ascontiguousarray(X[:, dofs]), w)
-                R[:, dofs] += F
-                dRdw[:, dofs] += dFw
-                J[np.ix_(self._nl_index, self._nl_index)] += dF
-        return R, J, dRdw
-
-    def support_reactions(self, X: np.ndarray, w: float) -> np.ndarray:
-        """Force the structure needs from its supports to move them, (n_coef, n_fixed):
-        the support DOFs' rows of ``Z X + F_nl - F_ex``."""
-        ZX, _, _ = self.linear_part(X, w)
-        R = ZX - self.Fex + self.nonlinear_forces(X, w)
-        return R[:, self.fixed]
+        nu = self.n_unknowns
+        J, dRw = np.empty((nu, nu)), np.empty(nu)
+        R = self._evaluate(X, float(w), J, dRw)
+        return R, J, dRw
 
     def __call__(self, x: np.ndarray):
         """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]``
         (n_u, n_u + 1), new arrays on every call."""
-        X = self.expand(x[:-1])
-        w = float(x[-1])
-        if self._all_free and self._templates is not None and (self._nl_all or not self.nl.n_nl):
-            return self._dense_call(x, X, w)
-        if self._all_free:
-            nu = X.size
-            Jw = np.zeros((nu, nu + 1))
-            R, _, dw = self._full_residual(X, w, Jw[:, :nu])
-            Jw[:, nu] = dw.reshape(-1)
-            return R.reshape(-1), Jw
-        R, J, dw = self.residual(X, w)
-        return R, np.hstack([J, dw[:, None]])
-
-    def _dense_call(self, x, X, w):
-        """:meth:`__call__` of a small dense model whose DOFs are all free and all touched
-        by elements (or none): one compiled assembly (:mod:`hbm.dense_kernels`)."""
-        nu = X.size
-        if self.nl.n_nl:
-            F, dF, dFw = self.nl.evaluate(X, w)
-        else:
-            F, dF, dFw = self._zero_forces
+        nu = self.n_unknowns
         A = np.empty((nu, nu + 1))
-        R = np.empty(nu)
-        Z0, Z1, Z2 = self._templates
-        dense_residual(Z0, Z1, Z2, w, np.ascontiguousarray(x[:-1]), self._fex_flat, F.reshape(-1),
-                       dF, dFw.reshape(-1), A[:, :nu], R, A[:, nu])
+        R = self._evaluate(self.expand(x[:-1]), float(x[-1]), A[:, :nu], A[:, nu])
         return R, A
 
-    def modal_data(self) -> ModalData:
-        """Every mode of the free DOFs seen from the free nonlinear DOFs (:mod:`hbm.modal_hill`);
-        supports with imposed motion are not perturbed.  Computed once."""
-        if self._modal is None:
-            dense = lambda A: A.toarray() if hasattr(A, "toarray") else np.asarray(A, dtype=float)
-            fr = np.ix_(self.free, self.free)
-            M, K, C = (dense(A)[fr] for A in (self.model.M, self.model.K, self.model.C))
-            rows = np.searchsorted(self.free, self.nl.dofs[self._nl_free])
-            self._modal = modal_data_of(M, K, C, rows)
-        return self._modal
+    def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray, dRw: np.ndarray) -> np.ndarray:
+        """``R`` (n_u,) returned; ``dR/dX`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw``."""
+        nl = self.nl
+        if not nl.n_nl:
+            J[...] = 0.0
+            Fn = dFw = np.zeros_like(X)
+        elif self._direct:
+            Fn, _, dFw = nl.evaluate(X, w, J_out=J)
+        else:
+            Fd, dFd, dFwd = nl.evaluate(np.ascontiguousarray(X[:, nl.dofs]), w)
+            J[...] = 0.0
+            J[np.ix_(self._u, self._u)] = dFd[np.ix_(self._k, self._k)]
+            Fn, dFw = np.zeros_like(X), np.zeros_like(X)
+            Fn[:, nl.dofs], dFw[:, nl.dofs] = Fd, dFwd
+        R = np.empty(J.shape[0])
+        self.linear.assemble(X, w, Fn, dFw, J, R, dRw)
+        return R
+
+    # ------------------------------------------------------------------ nonlinear part
+    def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
+        """``F_nl`` on every coordinate, (n_coef, n) (forces only: one AFT without seeds)."""
+        F = np.zeros_like(X, dtype=float)
+        if self.nl.n_nl:
+            d = self.nl.dofs
+            F[:, d] = self.nl.forces(np.ascontiguousarray(X[:, d], dtype=float), w)
+        return F
 
     def nonlinear_jacobian(self, X: np.ndarray, w: float, nl=None):
-        """``dF_nl/dX`` on the free nonlinear DOFs, (n_coef n_c, n_coef n_c), or ``None``.
+        """``dF_nl/dX`` on the free coordinates the elements read, (n_coef n_k, n_coef n_k),
+        ordered like :meth:`modal_rows`; ``None`` without such coordinates.
 
         ``nl`` : the elements' :class:`~hbm.aft.NonlinearForces` on another basis (``X`` then
-        has that basis' rows); default the problem's own."""
+        has that basis' rows); default the problem's own.
+        """
         nl = self.nl if nl is None else nl
         if not nl.n_nl or not self._nl_free.any():
             return None
@@ -253,68 +153,51 @@ class HarmonicBalance:
         k = (np.arange(nl.basis.n_coef)[:, None] * nl.n_nl + np.flatnonzero(self._nl_free)[None, :]).ravel()
         return dF[np.ix_(k, k)]
 
-    def recover_outputs(self, X: np.ndarray, w: float) -> np.ndarray:
-        """Output coefficients ``X G_o^T`` (n_coef, n_o) of a point ``X`` (n_coef, n)."""
-        return X @ self.output_rows.T
+    def stuck_stiffness(self) -> np.ndarray:
+        """Tangent stiffness of the elements at rest on the coordinates, (n, n)."""
+        K = np.zeros((self.n_dof, self.n_dof))
+        for e in self.nl.elements:
+            K += e.gather.T @ e.linear_stiffness() @ e.gather
+        return K
 
+    def stuck_damping(self) -> np.ndarray:
+        """Viscous tangent at rest of velocity-dependent elements (``linear_damping``), (n, n)."""
+        C = np.zeros((self.n_dof, self.n_dof))
+        for e in self.nl.elements:
+            cd = getattr(e, "linear_damping", None)
+            if cd is not None:
+                C += e.gather.T @ cd() @ e.gather
+        return C
+
+    # ------------------------------------------------------------------ what the analyses ask
     def modal_rows(self) -> np.ndarray:
-        """The DOFs (indices into ``n``) that :meth:`modal_data`'s ``phi_c`` rows stand for."""
+        """The coordinates (indices into ``n``) that :meth:`modal_data`'s ``phi_c`` rows stand
+        for: the free ones the elements read."""
         return self.nl.dofs[self._nl_free]
 
-    def linear_peak_amplitudes(self, ws, Ks, Cs=None):
-        """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear
-        responses (stuck: ``K + Ks``, ``C + Cs``), supports' imposed motion included.
+    def modal_data(self) -> ModalData:
+        """Modes of the linear part seen from :meth:`modal_rows` (:mod:`hbm.modal_hill`)."""
+        return self.linear.modal_data(self.modal_rows())
 
-        Returns
-        -------
-        free, stuck : ndarray, shape (n_free,)
-        """
-        fr, fx = self.free, self.fixed
-        amp_free, amp_stuck = np.zeros(fr.size), np.zeros(fr.size)
-        M, C, K = self.model.M, self.model.C, self.model.K
-        Cx = C if Cs is None else C + Cs
-        f = self.Fex[self.basis.row_of(1, "c"), fr]
-        yb = self.X_fixed[self.basis.row_of(1, "c"), fx]
-        for w in np.atleast_1d(ws):
-            for Kw, Cw, amp in ((K, C, amp_free), (K + Ks, Cx, amp_stuck)):
-                Zc = Kw - w * w * M + 1j * w * Cw
-                try:
-                    x = np.linalg.solve(Zc[np.ix_(fr, fr)], f - Zc[np.ix_(fr, fx)] @ yb)
-                except np.linalg.LinAlgError:
-                    continue
-                np.maximum(amp, np.abs(x), out=amp)
-        return amp_free, amp_stuck
+    def energy_balance(self, X: np.ndarray, w: float) -> EnergyBalance:
+        """Work per period of the excitation, the viscous and the nonlinear forces (:mod:`hbm.energy`)."""
+        Fn = self.nonlinear_forces(X, w)
+        w_ex, w_visc, bound = self.linear.work(X, w, Fn)
+        return EnergyBalance(w_ex, w_visc, work(self.basis, Fn, w * (self.basis.D @ X), w), bound)
 
-    def nonlinear_forces(self, X: np.ndarray, w: float) -> np.ndarray:
-        """``F_nl`` on all DOFs, (n_coef, n)."""
-        if self._nl_all:
-            return self.nl.forces(X, w)
-        F = np.zeros_like(X)
-        if self.nl.n_nl:
-            F[:, self.nl.dofs] = self.nl.forces(np.ascontiguousarray(X[:, self.nl.dofs]), w)
-        return F
+    def recover_outputs(self, X: np.ndarray, w: float) -> np.ndarray:
+        """Output coefficients (n_coef, n_o) of a point ``X`` (n_coef, n)."""
+        return self.linear.recover_outputs(X, w)
 
     def linear_solution(self, w: float, extra_stiffness=None) -> np.ndarray:
-        """Solution of ``(Z(w) + K_extra) X = F_ex`` (n_coef, n) with the supports' motion
-        imposed: the start of Newton.
+        """Solution of ``(Z(w) + K_extra) X = F(w)`` (n_coef, n): the start of Newton."""
+        return self.linear.linear_solution(w, extra_stiffness)
 
-        ``extra_stiffness`` (n, n) adds e.g. the stuck stiffness of the elements.
-        """
-        blocks, _ = harmonic_blocks(self.model, self.basis, w)
-        X = self.X_fixed.copy()
-        n = self.n_dof
-        fr = self.free
-        for h, s, B in zip(self.basis.harmonics, self._slices, blocks):
-            if extra_stiffness is not None:
-                B = B.copy()
-                for k in range(B.shape[0] // n):
-                    B[k * n:(k + 1) * n, k * n:(k + 1) * n] += extra_stiffness
-            nr = B.shape[0] // n
-            rows = slice(s.start // n, s.start // n + nr)
-            Xr = X[rows]
-            f_full = (self.Fex[rows].reshape(-1) - B @ Xr.reshape(-1)).reshape(nr, n)
-            if not np.any(f_full[:, fr]):
-                continue
-            Bb = B.reshape(nr, n, nr, n)[:, fr][:, :, :, fr].reshape(nr * fr.size, nr * fr.size)
-            Xr[:, fr] = np.linalg.solve(Bb, f_full[:, fr].reshape(-1)).reshape(nr, fr.size)
-        return X
+    def linear_peak_amplitudes(self, ws, stuck_stiffness, stuck_damping=None):
+        """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear
+        responses, (n_free,) each (:meth:`stuck_stiffness`, :meth:`stuck_damping`)."""
+        return self.linear.linear_peak_amplitudes(ws, stuck_stiffness, stuck_damping)
+
+    def load(self, w: float) -> np.ndarray:
+        """The load ``F(w)`` (n_coef, n) the linear part balances."""
+        return self.linear.load(w)

@@ -27,7 +27,7 @@ from .jumps import predict_jumps
 from .newton import newton
 from .curve_fill import fill_long_steps
 from .peak_refine import refine_peaks
-from .problem_setup import (_first_point, _residual_scale, _stuck_damping, _stuck_stiffness,  # noqa: F401
+from .problem_setup import (_first_point, _residual_scale,  # noqa: F401
                             _unknown_scale, build_problem, choose_solver, output_amplitudes,
                             recover_outputs, resolve_settings, setting_sources, solve_at)
 from .result import FRFResult, OutputSeries
@@ -97,7 +97,7 @@ def _step_limit(problem, case, window) -> ResonanceStepLimit:
     """The FRF's parameter-step limit at the linear resonances of the free and stuck limits
     (:mod:`hbm.resonances`) inside ``window`` (rad/s)."""
     d = np.ix_(problem.modal_rows(), problem.modal_rows())
-    om, z = linear_resonances(problem.modal_data(), _stuck_stiffness(problem)[d], _stuck_damping(problem)[d])
+    om, z = linear_resonances(problem.modal_data(), problem.stuck_stiffness()[d], problem.stuck_damping()[d])
     return ResonanceStepLimit(om, z, window)
 
 

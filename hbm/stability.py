@@ -375,8 +375,9 @@ class HillSystem:
 
     Parameters
     ----------
-    problem : HarmonicBalance or CondensedHarmonicBalance
-        Offers ``basis``, ``nl``, ``modal_data()`` and ``nonlinear_jacobian(X, w, nl)``.
+    problem : HarmonicBalance
+        On any linear part: offers ``basis``, ``nl``, ``modal_data()`` and
+        ``nonlinear_jacobian(X, w, nl)``.
     """
 
     def __init__(self, problem):

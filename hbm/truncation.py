@@ -78,7 +78,7 @@ def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
         NaN where the richer Jacobian is singular.
     """
     rp = richer_problem
-    out = np.full((len(ws), rp.output_rows.shape[0]), np.nan)
+    out = np.full((len(ws), rp.linear.output_rows.shape[0]), np.nan)
     for k, (X, w) in enumerate(zip(Xs, ws)):
         Xr = embed(X, problem.basis, rp.basis)
         R, J = rp.residual(Xr, float(w))[:2]

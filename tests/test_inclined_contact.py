@@ -9,7 +9,7 @@ import pytest
 
 import hbm
 from hbm.energy import energy_balance
-from hbm.residual import HarmonicBalance
+from hbm.dense_part import dense_balance
 from hbm.transforms import make_transform
 
 RIG = Path(__file__).resolve().parents[1] / "rigs" / "inclined_contact.toml"
@@ -90,7 +90,7 @@ def test_dissipation_output_matches_energy_balance(frfs, label):
     the energy balance (from the harmonics): equal up to the sampling of the period."""
     case, res = frfs[label]
     basis = res.basis
-    problem = HarmonicBalance(case.model, case.elements, basis, case.excitation.force,
+    problem = dense_balance(case.model, case.elements, basis, case.excitation.force,
                               make_transform(basis, "auto"))
     w_nl = np.array([energy_balance(problem, X, 2 * np.pi * f).nonlinear
                      for X, f in zip(res.X, res.freq_hz)])

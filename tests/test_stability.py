@@ -15,7 +15,7 @@ from hbm.cli import main
 from hbm.fourier import FourierBasis
 from hbm.jumps import predict_jumps, stable_pieces
 from hbm.linear import LinearModel
-from hbm.residual import HarmonicBalance
+from hbm.dense_part import dense_balance
 from hbm.stability import fold_exponents, hill_matrix, hill_stability, point_stability, select_exponents
 from hbm.transforms import make_transform
 
@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def linear_problem(model, basis):
     n = model.n_dof
-    return HarmonicBalance(model, [], basis, np.ones(n), make_transform(basis, "dft"))
+    return dense_balance(model, [], basis, np.ones(n), make_transform(basis, "dft"))
 
 
 def exact_exponents(model, w):
@@ -153,7 +153,7 @@ def test_duffing_middle_branch_unstable(H):
     # a real exponent crossed zero: on the middle branch it is real and positive
     mid = (ch[0] + ch[1]) // 2
     case = duffing_case(H)
-    prob = HarmonicBalance(case.model, case.elements, res.basis, case.excitation.force,
+    prob = dense_balance(case.model, case.elements, res.basis, case.excitation.force,
                            make_transform(res.basis, "dft"))
     r = point_stability(prob, res.X[mid], 2 * np.pi * res.freq_hz[mid])
     top = r.exponents[0]

@@ -5,7 +5,7 @@ import pytest
 
 import hbm
 import hbm.stability as stab
-from hbm.residual import HarmonicBalance
+from hbm.dense_part import dense_balance
 from hbm.stability import (hill_is_stable, hill_stability, point_is_stable, point_stability,
                            select_exponents, verdict_from_eigenvalues)
 from hbm.transforms import make_transform
@@ -94,7 +94,7 @@ def test_verdict_cases_by_hand():
                          ids=["duffing3", "duffing_h0", "jenkins"])
 def test_point_is_stable_equals_full_filter_along_frf(case, has_unstable):
     res = hbm.frf(case, stability=False)
-    prob = HarmonicBalance(case.model, case.elements, res.basis, case.excitation.force,
+    prob = dense_balance(case.model, case.elements, res.basis, case.excitation.force,
                            make_transform(res.basis, "dft"))
     full = [point_stability(prob, X, 2 * np.pi * f).stable for X, f in zip(res.X, res.freq_hz)]
     fast = [point_is_stable(prob, X, 2 * np.pi * f) for X, f in zip(res.X, res.freq_hz)]
@@ -105,7 +105,7 @@ def test_point_is_stable_equals_full_filter_along_frf(case, has_unstable):
 def test_undecided_verdict_falls_back_to_eigenvectors(monkeypatch):
     case = duffing_case(3)
     res = hbm.frf(case, stability=False)
-    prob = HarmonicBalance(case.model, case.elements, res.basis, case.excitation.force,
+    prob = dense_balance(case.model, case.elements, res.basis, case.excitation.force,
                            make_transform(res.basis, "dft"))
     calls = []
     real = stab.hill_stability

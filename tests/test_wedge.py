@@ -12,8 +12,8 @@ from hbm.case import CaseError, case_from_dict
 from hbm.fourier import FourierBasis
 from hbm.newton import newton
 from hbm.postprocess import element_summaries
-from hbm.residual import HarmonicBalance
-from hbm.response import _stuck_stiffness, _unknown_scale
+from hbm.dense_part import dense_balance
+from hbm.response import _unknown_scale
 from hbm.transforms import make_transform
 from elements.wedge_statics import static_normal_loads
 
@@ -191,21 +191,21 @@ def test_stuck_damper_is_linear_coupling(ppf):
 def grid_solutions(case, freqs, X0=None):
     """Harmonic-balance solutions along a frequency grid, Newton warm-started point to point."""
     b = FourierBasis(case.analysis.harmonics, case.analysis.time_samples)
-    p = HarmonicBalance(case.model, case.elements, b, case.excitation.force, make_transform(b, "auto"))
+    p = dense_balance(case.model, case.elements, b, case.excitation.force, make_transform(b, "auto"))
     sc = _unknown_scale(p, case, 2 * np.pi * freqs.min(), 2 * np.pi * freqs.max())
-    Ks = _stuck_stiffness(p)
+    Ks = p.stuck_stiffness()
     fs = float(np.linalg.norm(case.excitation.force))
     X, out = X0, []
     for f in freqs:
         w = 2 * np.pi * f
-        fun = lambda x, w=w: p.residual(x.reshape(p.Fex.shape), w)[:2]
+        fun = lambda x, w=w: p.residual(x.reshape(p.load(w).shape), w)[:2]
         starts = ([X] if X is not None else []) + [p.linear_solution(w, Ks), p.linear_solution(w)]
         for g in starts:
             res = newton(fun, g.ravel(), scale=sc, r_scale=fs, max_iter=40)
             if res.converged:
                 break
         assert res.converged, (f, res.message)
-        X = res.x.reshape(p.Fex.shape)
+        X = res.x.reshape(p.load(w).shape)
         out.append(X)
     return b, p, np.array(out)
 
@@ -299,7 +299,7 @@ def test_exact_jacobian_with_damper_dofs_and_rotation(amp):
     data["element"][0]["centres"] = [[-0.006, 0.002], [0.004, 0.0035]]
     case = case_from_dict(data)
     b = FourierBasis(np.arange(0, 4), 64)
-    p = HarmonicBalance(case.model, case.elements, b, case.excitation.force, make_transform(b, "dft"))
+    p = dense_balance(case.model, case.elements, b, case.excitation.force, make_transform(b, "dft"))
     rng = np.random.default_rng(7)
     n = case.n_dof
     scale = np.full(n, amp)
