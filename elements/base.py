@@ -20,7 +20,7 @@ class LawSpec:
     Attributes
     ----------
     kind : int
-        Law id (:mod:`elements.kinds`).
+        Law id (:mod:`elements.laws.registry`).
     params : ndarray, shape (n_p,)
     n_state : int
     closure : int

@@ -63,7 +63,7 @@ from .base import (Element, LawSpec, coordinate_rows, require_keys, positive, no
                    principal_reversal)
 from .friction3d import Friction3D
 from .hertz import hertz_contact
-from .kinds import FRICTION3D
+from .laws.registry import FRICTION3D
 
 
 def static_approach(h: np.ndarray, weight: np.ndarray, kn: float, load: float) -> float:

@@ -6,7 +6,7 @@ import numpy as np
 
 from .base import Element, coordinate_rows, require_keys, positive, non_negative
 from .law_march import START_PRINCIPAL, CLOSE_NEWTON
-from .kinds import FRICTION3D
+from .laws.registry import FRICTION3D
 
 
 class Friction3D(Element):

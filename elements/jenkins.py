@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
-from .kinds import JENKINS
+from .laws.registry import JENKINS
 from .law_march import START_ARGMAX
 
 

@@ -23,43 +23,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .kinds import JENKINS, CUBIC, FRICTION3D, COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
-from .laws.jenkins import jenkins_step, jenkins_init
-from .laws.cubic import cubic_step, cubic_init
-from .laws.friction3d import friction3d_step, friction3d_init
-from .laws.coulomb import coulomb_sk_step, coulomb_sk_init, coulomb_reg_step, coulomb_reg_init
-
-
-def _law_step(kind, p, s, z, s_new, A, B):
-    """Dispatch one incremental update to the law ``kind`` (see module docstring)."""
-    if kind == JENKINS:
-        jenkins_step(p, s, z, s_new, A, B)
-    elif kind == CUBIC:
-        cubic_step(p, s, z, s_new, A, B)
-    elif kind == FRICTION3D:
-        friction3d_step(p, s, z, s_new, A, B)
-    elif kind == COULOMB_STATIC_KINETIC:
-        coulomb_sk_step(p, s, z, s_new, A, B)
-    elif kind == COULOMB_REGULARISED:
-        coulomb_reg_step(p, s, z, s_new, A, B)
-    else:
-        raise ValueError("unknown law kind")
-
-
-def _law_init(kind, p, z0, s0, C0):
-    """Rest state ``s0`` at input ``z0`` reached from ``q = 0``, and ``C0 = ds0/dz0``."""
-    if kind == JENKINS:
-        jenkins_init(p, z0, s0, C0)
-    elif kind == CUBIC:
-        cubic_init(p, z0, s0, C0)
-    elif kind == FRICTION3D:
-        friction3d_init(p, z0, s0, C0)
-    elif kind == COULOMB_STATIC_KINETIC:
-        coulomb_sk_init(p, z0, s0, C0)
-    elif kind == COULOMB_REGULARISED:
-        coulomb_reg_init(p, z0, s0, C0)
-    else:
-        raise ValueError("unknown law kind")
+from .laws.registry import _law_init, _law_step
 
 
 # One dispatch text, two compilations: a called kernel for the time integrator
@@ -212,7 +176,7 @@ def march(kind, p, n_state, n_local, z, dz, start, max_passes, tol):
     Parameters
     ----------
     kind : int
-        Law id (``elements.kinds``).
+        Law id (:mod:`elements.laws.registry`).
     p : ndarray, shape (n_p,)
         Law parameters.
     n_state, n_local : int

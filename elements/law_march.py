@@ -28,16 +28,10 @@ import math
 import numba as nb
 import numpy as np
 
-from .kinds import JENKINS, FRICTION3D
 from .kernels import march_body
 from .closure import newton_body
-
-START_FIRST = 0
-START_ARGMAX = 1
-START_PRINCIPAL = 2
-
-CLOSE_PLAIN = 0
-CLOSE_NEWTON = 1
+from .laws.record import CLOSE_NEWTON, CLOSE_PLAIN, START_ARGMAX, START_FIRST, START_PRINCIPAL  # noqa: F401
+from .laws.registry import _law_linear
 
 
 @nb.njit(cache=True)
@@ -103,53 +97,10 @@ def start_sample(rule, n_start, u):
     return 0
 
 
-@nb.njit(cache=True)
-def linear_shortcut(kind, p, z, K, f0):
-    """True if the law is linear, ``f = f0 + K z``, at every sample of ``z`` (N, nz).
-
-    Writes ``K`` (n_local, nz) and ``f0`` (n_local,) when it returns True.
-    """
-    N = z.shape[0]
-    if kind == JENKINS:
-        kt = p[0]
-        fs = p[1]
-        for j in range(N):
-            if abs(kt * z[j, 0]) > fs:
-                return False
-        K[0, 0] = kt
-        f0[0] = 0.0
-        return True
-    if kind == FRICTION3D:
-        kt = p[0]
-        kn = p[1]
-        mu = p[2]
-        N0 = p[3]
-        nt = int(p[4])
-        n_open = 0
-        for j in range(N):
-            Nload = N0 + kn * z[j, nt]
-            if Nload <= 0.0:
-                n_open += 1
-                continue
-            if n_open > 0:
-                return False
-            g2 = 0.0
-            for a in range(nt):
-                g2 += (kt * z[j, a]) ** 2
-            if math.sqrt(g2) > mu * Nload:
-                return False
-        K[:, :] = 0.0
-        f0[:] = 0.0
-        if n_open == N:
-            f0[nt] = -N0
-            return True
-        if n_open > 0:
-            return False
-        for a in range(nt):
-            K[a, a] = kt
-        K[nt, nt] = kn
-        return True
-    return False
+linear_shortcut = nb.njit(cache=True)(_law_linear)
+linear_shortcut.__doc__ = """True if the law is linear, ``f = f0 + K z``, at every sample of ``z`` (N, nz);
+writes ``K`` (n_local, nz) and ``f0`` (n_local,) when it returns True
+(:func:`elements.laws.registry._law_linear`)."""
 
 
 def make_law_march(kind, closure):

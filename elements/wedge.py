@@ -40,7 +40,7 @@ import numpy as np
 
 from .base import Element, coordinate
 from .friction3d import Friction3D
-from .kinds import FRICTION3D
+from .laws.registry import FRICTION3D
 from .wedge_params import KEYS, WedgeParams, parse_params, _sides
 from .wedge_statics import flank_frames
 

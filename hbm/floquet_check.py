@@ -129,7 +129,7 @@ CONFIRM_STEPS = 1024
 
 
 def _non_smooth(packed) -> bool:
-    from elements.kinds import COULOMB_REGULARISED, CUBIC
+    from elements.laws.registry import COULOMB_REGULARISED, CUBIC
     return bool(np.any(~np.isin(packed.laws[0], (CUBIC, COULOMB_REGULARISED))))
 
 

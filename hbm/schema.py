@@ -9,6 +9,8 @@ compares the two, so it cannot drift from what the loader accepts.
 """
 from __future__ import annotations
 
+from elements.laws.registry import CASE_LAWS
+
 TABLES = {
     "top level": {
         "name": "string; the case's title in outputs and plots (default: the file name)",
@@ -66,7 +68,6 @@ ELEMENT_KEYS = {
 
 ELEMENTS = {
     "jenkins": {"kt": "tangential stiffness, N/m", "slip_force": "slip force, N"},
-    "cubic": {"k3": "cubic stiffness, N/m^3: f = k3 x^3"},
     "friction3d": {"kt": "tangential stiffness, N/m", "kn": "normal stiffness, N/m",
                    "mu": "friction coefficient", "normal_preload": "static normal load N0 >= 0, N "
                    "(the contact opens when N0 + kn u_n falls to 0)"},
@@ -97,6 +98,8 @@ ELEMENTS = {
                      "points_per_flank": "contact points per flank (>= 2: the damper rotates)",
                      "flank_length": "flank length L, m (points_per_flank >= 2)",
                      "centres": "`[[xL, yL], [xR, yR]]`: flank centres from the damper's CG, m"},
+    # laws registered as case types document their parameters in their records
+    **{rec.name: {key: doc for key, _, doc in rec.params} for rec in CASE_LAWS.values()},
 }
 
 BUILDER = {

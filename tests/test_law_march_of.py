@@ -5,7 +5,7 @@ import pytest
 
 from elements.closure import march_newton
 from elements.kernels import march
-from elements.kinds import JENKINS, CUBIC, FRICTION3D, COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
+from elements.laws.registry import JENKINS, CUBIC, FRICTION3D, COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
 from elements.law_march import march_of, CLOSE_PLAIN, CLOSE_NEWTON
 
 N = 48

@@ -42,7 +42,7 @@ import numba as nb
 import numpy as np
 
 from ..closure import march_newton
-from ..kinds import FRICTION3D
+from .registry import FRICTION3D
 
 
 @nb.njit(cache=True)

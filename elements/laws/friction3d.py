@@ -139,3 +139,40 @@ def friction3d_init(p, z0, s0, C0):
     t1 = kt * z0[1] if nt == 2 else 0.0
     f0, f1, r, d0, d1, slipping = _radial_return(p[2] * Nload, kt * z0[0], t1)
     _write_tangential(kt, p[2], p[1], nt, nt + 1, f0, f1, r, d0, d1, slipping, s0, C0, C0, False)
+
+
+@nb.njit(cache=True, inline="always")
+def friction3d_linear(p, z, K, f0):
+    """True when the contact is linear at every sample: closed and stuck from rest
+    (``K = diag(kt, ..., kt, kn)``, ``f0 = 0``), or open throughout (``K = 0``,
+    ``f0 = [0, ..., -N0]``)."""
+    kt = p[0]
+    kn = p[1]
+    mu = p[2]
+    N0 = p[3]
+    nt = int(p[4])
+    N = z.shape[0]
+    n_open = 0
+    for j in range(N):
+        Nload = N0 + kn * z[j, nt]
+        if Nload <= 0.0:
+            n_open += 1
+            continue
+        if n_open > 0:
+            return False
+        g2 = 0.0
+        for a in range(nt):
+            g2 += (kt * z[j, a]) ** 2
+        if math.sqrt(g2) > mu * Nload:
+            return False
+    K[:, :] = 0.0
+    f0[:] = 0.0
+    if n_open == N:
+        f0[nt] = -N0
+        return True
+    if n_open > 0:
+        return False
+    for a in range(nt):
+        K[a, a] = kt
+    K[nt, nt] = kn
+    return True

@@ -56,3 +56,16 @@ def jenkins_init(p, z0, s0, C0):
         s0[0] = fs if f > 0.0 else -fs
     s0[1] = z0[0]
     C0[1, 0] = 1.0
+
+
+@nb.njit(cache=True, inline="always")
+def jenkins_linear(p, z, K, f0):
+    """True when the slider sticks at every sample from rest (``|kt u| <= fs``): ``f = kt u``."""
+    kt = p[0]
+    fs = p[1]
+    for j in range(z.shape[0]):
+        if abs(kt * z[j, 0]) > fs:
+            return False
+    K[0, 0] = kt
+    f0[0] = 0.0
+    return True
