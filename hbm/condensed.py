@@ -46,7 +46,8 @@ from .condensed_linear import LinearBuilder, LinearPart
 from .contact_coordinates import contact_coordinates, regathered
 from .fourier import FourierBasis
 from .modal_hill import ModalData
-from .reduction import ReducedModel, condense
+from .condensed_model import condense
+from .reduction import ReducedModel
 from .residual import HarmonicBalance
 
 
@@ -278,7 +279,7 @@ class CondensedLinear:
     def recover_outputs(self, X: np.ndarray, w: float) -> np.ndarray:
         """Output coefficients ``Y = H_oe F_e - H_oc F'`` (n_coef, n_o) from the contact
         coefficients ``X`` (n_coef, n_c); equal to ``T_oc U + T_oe F_e`` of
-        :meth:`hbm.reduction.CondensedModel.recover_outputs`."""
+        :meth:`hbm.condensed_model.CondensedModel.recover_outputs`."""
         L = self.at(w)
         return self._respond("o", self._implied_forces(X, L), L)
 

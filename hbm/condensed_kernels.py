@@ -8,7 +8,7 @@ Modal receptances (proportional damping), for every ``W_k = h_k w``:
     d_r = \omega_r^2 - W^2 + i W c_r, \qquad
     \frac{dH}{dW} = \sum_r \frac{2W - i c_r}{d_r^2}\, \phi_r \phi_r^T .
 
-Condensed stiffness and its real block form on the unknown vector (:mod:`hbm.reduction`):
+Condensed stiffness and its real block form on the unknown vector (:mod:`hbm.real_blocks`):
 
 .. math::
 

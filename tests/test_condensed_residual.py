@@ -1,5 +1,5 @@
 """The condensed residual (all harmonics at once, compiled linear part) against the per-harmonic
-blocks of :class:`hbm.reduction.CondensedModel`, finite differences and its own energy check."""
+blocks of :class:`hbm.condensed_model.CondensedModel`, finite differences and its own energy check."""
 import numpy as np
 import pytest
 
@@ -7,7 +7,7 @@ from hbm.case import case_from_dict
 from hbm.condensed import CondensedLinear, condensed_balance
 from hbm.condensed_kernels import _invert
 from hbm.fourier import FourierBasis
-from hbm.reduction import apply_blocks
+from hbm.real_blocks import apply_blocks
 from hbm.response import build_problem
 
 

@@ -5,7 +5,9 @@ import scipy.sparse as sp
 
 from hbm.fourier import FourierBasis
 from hbm.linear import LinearModel, harmonic_blocks
-from hbm.reduction import apply_blocks, condense, real_block, reduce_model, reduce_linear_model
+from hbm.condensed_model import condense
+from hbm.real_blocks import apply_blocks, real_block
+from hbm.reduction import reduce_model, reduce_linear_model
 
 
 def chain(n=30, seed=0):
