@@ -12,7 +12,7 @@ Schema (every key and its meaning: :mod:`hbm.schema`, ``docs/case-reference.md``
                   solver:      solver = "auto" | "full" | "condensed", modes = 40 | "all",
                                residual_flexibility = true            (hbm.structure)
     [[element]]   type = "<registry key>", dofs = ..., law keys  (elements may add internal
-                  DOFs to the model, e.g. a damper body: see ``_with_internal_dofs``)
+                  DOFs to the model, e.g. a damper body: :mod:`hbm.case_elements`)
     [excitation]  dofs = [...], amplitude = [...]        (cosine at the first harmonic, N)
                   base = { dofs = [...], amplitude = [...] }   (imposed support motion, m)
     [analysis]    harmonics, time_samples, frequency_hz = [lo, hi], max_points, transform,
@@ -36,35 +36,23 @@ Every unknown key is an error naming the key and the file.  Errors are :class:`C
 from __future__ import annotations
 
 import copy
-import math
 import tomllib
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sla
 
-from elements import ELEMENTS
-from elements.base import MAGNITUDE_MAX, coordinate_row, did_you_mean
+from elements.base import coordinate_row
 
 from .fourier import parse_harmonics, min_samples, default_samples
 from .linear import LinearModel
-from .model_io import load_model_file
+from .case_checks import CaseError, as_number, check_keys
+from .case_elements import LINEAR_DEFAULT, build_elements, element_defaults, element_specs, with_internal_dofs  # noqa: F401
+from .case_model import MODEL_KEYS, model_from_table  # noqa: F401  (MODEL_KEYS: public here)
 from .schema import table_keys
-from .structure import Damping, ReductionSettings, Structure
-
-EAGER_CHECK_DOF = 60       # dense models up to this size are fully validated at load time
-
-
-class CaseError(ValueError):
-    """Bad input in a case file or on the command line (one-line message)."""
-
+from .structure import ReductionSettings, Structure
 
 TOP_KEYS = table_keys("top level")
-MODEL_KEYS = table_keys("[model]")
-BUILDER_TABLES = ("beam", "body", "spring")
-BUILDERS = ("beam",)
 EXCITATION_KEYS = table_keys("[excitation]")
 BASE_KEYS = table_keys("[excitation] base")
 ANALYSIS_KEYS = table_keys("[analysis]")
@@ -150,233 +138,6 @@ class Case:
         return self.structure.n_dof
 
 
-def _check_keys(table, allowed, where, path):
-    if not isinstance(table, dict):
-        raise CaseError(f"{path}: {where} must be a table")
-    for k in table:
-        if k not in allowed:
-            raise CaseError(f"{path}: unknown key {k!r} in {where}{did_you_mean(k, allowed)} "
-                            f"(allowed: {', '.join(allowed)})")
-
-
-def _matrix(value, name, path):
-    try:
-        A = np.array(value, dtype=float)
-        if any(isinstance(v, bool) for v in np.array(value, dtype=object).ravel()):
-            raise ValueError("booleans")       # float() would turn true into 1.0
-    except (TypeError, ValueError):
-        raise CaseError(f"{path}: [model] {name} must be a matrix of numbers") from None
-    if A.ndim == 0:
-        A = A.reshape(1, 1)
-    if A.ndim == 1:
-        A = np.diag(A)
-    if A.ndim != 2:
-        raise CaseError(f"{path}: [model] {name} must be a matrix (list of rows)")
-    if np.any(np.abs(A[np.isfinite(A)]) > MAGNITUDE_MAX):
-        raise CaseError(f"{path}: [model] {name} has entries above {MAGNITUDE_MAX:g} in magnitude "
-                        f"(products would overflow)")
-    return A
-
-
-def _number(value, name, path, *, positive=False, integer=False):
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if integer:
-        ok = ok and isinstance(value, int)
-    if not ok or not math.isfinite(value):
-        raise CaseError(f"{path}: {name} must be {'an integer' if integer else 'a number'}, got {value!r}")
-    if abs(value) > MAGNITUDE_MAX:
-        raise CaseError(f"{path}: {name} = {value!r} is out of range (|value| > {MAGNITUDE_MAX:g})")
-    if positive and value <= 0:
-        raise CaseError(f"{path}: {name} must be > 0, got {value!r}")
-    return value
-
-
-def _damping(t, path, n):
-    given = [k for k in ("damping", "rayleigh", "modal_damping") if k in t]
-    if len(given) > 1:
-        raise CaseError(f"{path}: [model] give only one of damping, rayleigh, modal_damping")
-    if not given:
-        return None
-    k = given[0]
-    v = t[k]
-    if k == "damping":
-        C = _matrix(v, "damping", path)
-        if C.shape != (n, n):
-            raise CaseError(f"{path}: [model] damping must be {n}x{n} like the mass matrix, got {C.shape}")
-        return Damping("matrix", C)
-    if k == "rayleigh":
-        if not (isinstance(v, list) and len(v) == 2):
-            raise CaseError(f"{path}: [model] rayleigh must be a pair [a, b]")
-        return Damping("rayleigh", tuple(_number(x, "[model] rayleigh", path) for x in v))
-    if isinstance(v, list):
-        z = [_number(x, "[model] modal_damping", path) for x in v]
-    else:
-        z = _number(v, "[model] modal_damping", path)
-    if np.any(np.asarray(z) < 0):
-        raise CaseError(f"{path}: [model] modal_damping ratios must be >= 0")
-    return Damping("modal", z)
-
-
-def _reduction_settings(t, path):
-    modes = t.get("modes")
-    if modes == "all":
-        modes = -1
-    elif modes is not None:
-        _number(modes, "[model] modes", path, positive=True, integer=True)
-    rf = t.get("residual_flexibility", True)
-    if not isinstance(rf, bool):
-        raise CaseError(f"{path}: [model] residual_flexibility must be true or false, got {rf!r}")
-    solver = t.get("solver", "auto")
-    try:
-        return ReductionSettings(solver, modes if modes != -1 else None, rf), modes == -1
-    except ValueError as exc:
-        raise CaseError(f"{path}: [model] {exc}") from None
-
-
-def _model(t, path, base_dir):
-    """``[model]`` -> (Structure, ReductionSettings)."""
-    _check_keys(t, MODEL_KEYS, "[model]", path)
-    sources = [k for k in ("file", "builder") if k in t] + (["mass/stiffness"] if "mass" in t or "stiffness" in t else [])
-    if len(sources) != 1:
-        got = [f"file = {t['file']!r}" if k == "file" else k for k in sources]
-        raise CaseError(f"{path}: [model] give exactly one model source: mass/stiffness, file or builder"
-                        + (f" (got {', '.join(got)})" if sources else ""))
-    if "builder" not in t:
-        for k in BUILDER_TABLES:
-            if k in t:
-                raise CaseError(f"{path}: [model] {k} needs builder = \"beam\"")
-    names = ()
-    points = {}
-    C_file = None
-    if "file" in t:
-        if not isinstance(t["file"], str):
-            raise CaseError(f"{path}: [model] file must be a path (string), got {t['file']!r}")
-        f = base_dir / t["file"]
-        if not f.is_file():
-            raise CaseError(f"{path}: [model] file {str(f)!r} not found")
-        try:
-            data = load_model_file(f)
-        except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile) as exc:
-            msg = " ".join(str(exc).split())
-            raise CaseError(f"{path}: [model] cannot read model file {str(f)!r}: {msg}") from None
-        M, K, C_file, names = data.M, data.K, data.C, data.dof_names
-        if "dof_names" in t:
-            if names:
-                raise CaseError(f"{path}: [model] dof_names given but the model file names its DOFs")
-            names = tuple(t["dof_names"])
-    elif "builder" in t:
-        if t["builder"] not in BUILDERS:
-            raise CaseError(f"{path}: [model] unknown builder {t['builder']!r} (known: {', '.join(BUILDERS)})")
-        if "dof_names" in t:
-            raise CaseError(f"{path}: [model] dof_names cannot be given with a builder (it names the DOFs)")
-        from hbm.builders.assembly import build_assembly
-        try:
-            a = build_assembly(t.get("beam", []), t.get("body", []), t.get("spring", []))
-        except ValueError as exc:
-            raise CaseError(f"{path}: {exc}") from None
-        M, K, names, points = a.M, a.K, a.dof_names, a.points
-    else:
-        for k in ("mass", "stiffness"):
-            if k not in t:
-                raise CaseError(f"{path}: [model] missing key {k!r}")
-        M, K = _matrix(t["mass"], "mass", path), _matrix(t["stiffness"], "stiffness", path)
-        names = t.get("dof_names", [])
-        if not (isinstance(names, list) and all(isinstance(x, str) for x in names)):
-            raise CaseError(f"{path}: [model] dof_names must be a list of strings, got {names!r}")
-        dup = sorted({x for x in names if names.count(x) > 1})
-        if dup:
-            raise CaseError(f"{path}: [model] dof_names repeats {dup[0]!r}")
-        names = tuple(names)
-    for name, A in (("mass", M), ("stiffness", K)):
-        if A.ndim != 2 or A.shape[0] != A.shape[1]:
-            raise CaseError(f"{path}: [model] {name} matrix must be square, got shape {A.shape}")
-    if K.shape != M.shape:
-        raise CaseError(f"{path}: [model] stiffness must be {M.shape[0]}x{M.shape[0]} like the mass "
-                        f"matrix, got {K.shape}")
-    damping = _damping(t, path, M.shape[0])
-    if damping is None:
-        damping = Damping("matrix", C_file) if C_file is not None else Damping()
-    settings, all_modes = _reduction_settings(t, path)
-    try:
-        st = Structure(M, K, damping, tuple(str(s) for s in names), points)
-        if all_modes:
-            settings = ReductionSettings(settings.solver, st.n_dof, settings.residual_flexibility)
-        if settings.modes is not None and settings.modes > st.max_modes:
-            raise ValueError(f"modes = {settings.modes} is more than the {st.max_modes} modes "
-                             f"a model of {st.n_dof} DOFs allows")
-        if not st.sparse and st.n_dof <= EAGER_CHECK_DOF:
-            st.linear_model()          # full validation (definiteness) while it is cheap
-    except ValueError as exc:
-        raise CaseError(f"{path}: [model] {exc}") from None
-    return st, settings
-
-
-def _element_specs(specs, path):
-    """``(class, spec with its name, where)`` per ``[[element]]`` table, types checked."""
-    if not isinstance(specs, list):
-        raise CaseError(f"{path}: [[element]] must be an array of tables")
-    out = []
-    for i, spec in enumerate(specs):
-        where = f"[[element]] #{i}"
-        if not isinstance(spec, dict):
-            raise CaseError(f"{path}: {where} must be a table")
-        typ = spec.get("type")
-        if typ is None:
-            raise CaseError(f"{path}: {where}: missing key 'type'")
-        if not isinstance(typ, str):
-            raise CaseError(f"{path}: {where}: type must be a string (known: {', '.join(ELEMENTS)}), got {typ!r}")
-        cls = ELEMENTS.get(typ)
-        if cls is None:
-            raise CaseError(f"{path}: {where}: unknown element type {typ!r} (known: {', '.join(ELEMENTS)})")
-        spec = dict(spec)
-        spec.setdefault("name", f"{typ}{i}")
-        out.append((cls, spec, f"{where} ({typ})"))
-    return out
-
-
-def _with_internal_dofs(structure: Structure, specs, path) -> Structure:
-    """The structure with the internal DOFs of the elements appended.
-
-    Hook: an element class may define a classmethod ``internal_dofs(spec, where) ->
-    (names, M_int, K_int)`` (e.g. the body of a wedge damper).  Its DOFs are appended in
-    element order, block diagonal, undamped, named as returned (``"<element name>.x"`` ...),
-    so that ``from_spec`` (called afterwards with the augmented size and name map) finds
-    them, and excitation and outputs may name them.
-    """
-    names, Ms, Ks = [], [], []
-    for cls, spec, where in specs:
-        hook = getattr(cls, "internal_dofs", None)
-        if hook is None:
-            continue
-        try:
-            n, Mi, Ki = hook(spec, where)
-        except ValueError as exc:
-            raise CaseError(f"{path}: {exc}") from None
-        names += list(n)
-        Ms.append(Mi)
-        Ks.append(Ki)
-    if not names:
-        return structure
-    try:
-        return structure.with_internal_dofs(names, sla.block_diag(*Ms), sla.block_diag(*Ks))
-    except ValueError as exc:
-        raise CaseError(f"{path}: element DOFs: {exc}") from None
-
-
-def _elements(specs, structure: Structure, path):
-    coords = structure.coordinates()
-    out = []
-    for cls, spec, where in specs:
-        try:
-            out.append(cls.from_spec(spec, structure.n_dof, coords, where))
-        except ValueError as exc:
-            msg = str(exc)
-            if not msg.startswith(where.split(" (")[0]):       # a law parameter check: say which element
-                msg = f"{where}: {msg}"
-            raise CaseError(f"{path}: {msg}") from None
-    return tuple(out)
-
-
 def _force_rows(t, model, coords, where, path):
     """``(rows (k, n), amplitudes (k,))`` of a ``dofs`` / ``amplitude`` pair of lists."""
     for k in ("dofs", "amplitude"):
@@ -386,11 +147,11 @@ def _force_rows(t, model, coords, where, path):
     if not isinstance(dofs, list) or not isinstance(amp, list) or len(dofs) != len(amp) or not dofs:
         raise CaseError(f"{path}: {where} dofs and amplitude must be lists of the same length")
     rows = np.array([_row(d, model, coords, f"{where} dofs", path) for d in dofs])
-    return rows, np.array([_number(a, f"{where} amplitude", path) for a in amp])
+    return rows, np.array([as_number(a, f"{where} amplitude", path) for a in amp])
 
 
 def _excitation(t, model, path):
-    _check_keys(t, EXCITATION_KEYS, "[excitation]", path)
+    check_keys(t, EXCITATION_KEYS, "[excitation]", path)
     coords = model.coordinates()
     force, force_sine = np.zeros(model.n_dof), np.zeros(model.n_dof)
     if "dofs" in t or "amplitude" in t or "base" not in t:
@@ -402,7 +163,7 @@ def _excitation(t, model, path):
         raise CaseError(f"{path}: [excitation] phase_deg needs dofs and amplitude (it phases the forces)")
     base = None
     if "base" in t:
-        _check_keys(t["base"], BASE_KEYS, "[excitation] base", path)
+        check_keys(t["base"], BASE_KEYS, "[excitation] base", path)
         rows, ba = _force_rows(t["base"], model, coords, "[excitation] base", path)
         if np.any(np.count_nonzero(rows, axis=1) != 1) or np.any(rows[rows != 0] != 1.0):
             raise CaseError(f"{path}: [excitation] base dofs must be single DOFs (the supports)")
@@ -426,7 +187,7 @@ def _phases(t, k, path) -> np.ndarray:
     ph = t["phase_deg"]
     if not isinstance(ph, list) or len(ph) != k:
         raise CaseError(f"{path}: [excitation] phase_deg must be a list of {k} phases in degrees, one per DOF")
-    return np.array([_number(p, "[excitation] phase_deg", path) for p in ph])
+    return np.array([as_number(p, "[excitation] phase_deg", path) for p in ph])
 
 
 def _row(spec, model, coords, where, path) -> np.ndarray:
@@ -455,32 +216,8 @@ def _element_output(key, value, elements, path):
     return hits[0], qty
 
 
-LINEAR_DEFAULT = (1, 1)     # (H, samples factor) of a case without elements
-
-
-def element_defaults(elements) -> tuple:
-    """Default ``(H, samples factor)`` of a case with these elements.
-
-    The largest ``default_harmonics`` and the largest ``default_samples_factor`` over the
-    elements' classes (:class:`elements.Element`); ``LINEAR_DEFAULT`` = (1, 1) without
-    elements.
-
-    Parameters
-    ----------
-    elements : sequence of Element
-
-    Returns
-    -------
-    (int, int)
-    """
-    if not elements:
-        return LINEAR_DEFAULT
-    return (max(int(type(e).default_harmonics) for e in elements),
-            max(int(type(e).default_samples_factor) for e in elements))
-
-
 def _analysis(t, model, elements, path):
-    _check_keys(t, ANALYSIS_KEYS, "[analysis]", path)
+    check_keys(t, ANALYSIS_KEYS, "[analysis]", path)
     for k in ("frequency_hz", "outputs"):
         if k not in t:
             raise CaseError(f"{path}: [analysis] missing key {k!r}")
@@ -496,14 +233,14 @@ def _analysis(t, model, elements, path):
     if 1 not in h:
         raise CaseError(f"{path}: [analysis] harmonics must include 1 (the excitation's harmonic)")
     N = t.get("time_samples", default_samples(h, factor))
-    _number(N, "[analysis] time_samples", path, positive=True, integer=True)
+    as_number(N, "[analysis] time_samples", path, positive=True, integer=True)
     if N < min_samples(h):
         raise CaseError(f"{path}: [analysis] time_samples={N} too small for harmonics up to {h.max()} "
                         f"(need >= {min_samples(h)})")
     fr = t["frequency_hz"]
     if not (isinstance(fr, list) and len(fr) == 2):
         raise CaseError(f"{path}: [analysis] frequency_hz must be [start, end]")
-    lo, hi = (_number(v, "[analysis] frequency_hz", path, positive=True) for v in fr)
+    lo, hi = (as_number(v, "[analysis] frequency_hz", path, positive=True) for v in fr)
     if not hi > lo:
         raise CaseError(f"{path}: [analysis] frequency range is empty ({lo} .. {hi} Hz)")
     outs = t["outputs"]
@@ -523,7 +260,7 @@ def _analysis(t, model, elements, path):
         if columns.count(c) > 1 or c in ("freq_hz", "stable"):
             raise CaseError(f"{path}: [analysis] outputs: column {c!r} of frf.csv would appear twice; "
                             f"rename an output")
-    mp = _number(t.get("max_points", 2000), "[analysis] max_points", path, positive=True, integer=True)
+    mp = as_number(t.get("max_points", 2000), "[analysis] max_points", path, positive=True, integer=True)
     tr = t.get("transform", "auto")
     if tr not in ("auto", "dft", "numpy", "fftw"):
         raise CaseError(f"{path}: [analysis] transform must be auto, dft, numpy or fftw, got {tr!r}")
@@ -536,14 +273,14 @@ def case_from_dict(data: dict, path: str = "<case>", base_dir: Path | None = Non
     """Validate a parsed case table and build the :class:`Case`."""
     path = str(path)
     base_dir = Path(base_dir or ".")
-    _check_keys(data, TOP_KEYS, "the top level", path)
+    check_keys(data, TOP_KEYS, "the top level", path)
     for k in ("model", "excitation", "analysis"):
         if k not in data:
             raise CaseError(f"{path}: missing table [{k}]")
-    structure, settings = _model(data["model"], path, base_dir)
-    specs = _element_specs(data.get("element", []), path)
-    structure = _with_internal_dofs(structure, specs, path)
-    elements = _elements(specs, structure, path)
+    structure, settings = model_from_table(data["model"], path, base_dir)
+    specs = element_specs(data.get("element", []), path)
+    structure = with_internal_dofs(structure, specs, path)
+    elements = build_elements(specs, structure, path)
     excitation = _excitation(data["excitation"], structure, path)
     analysis = _analysis(data["analysis"], structure, elements, path)
     name = data.get("name", Path(path).stem)
