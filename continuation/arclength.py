@@ -55,38 +55,11 @@ import numpy as np
 from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
 from .linsolve import REUSE_MIN_SIZE, ReusedLU, direct_solve
 from .kernels import step_geometry
-from .options import ArclengthOptions
+from .options import ArclengthOptions, default_scale
 from .point import ContinuationPoint
 from .tangent import fold_parameter, null_tangent
 
 Fun = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
-
-
-def default_scale(x0: np.ndarray, lam_bounds: tuple[float, float]) -> np.ndarray:
-    """Per-unknown scales derived from the start (see module doc).
-
-    Parameters
-    ----------
-    x0 : ndarray, shape (n+1,)
-        Starting point ``[y0, lam0]``.
-    lam_bounds : (float, float)
-        Parameter bounds.
-
-    Returns
-    -------
-    ndarray, shape (n+1,)
-        Positive scales.
-    """
-    y0 = np.abs(x0[:-1])
-    ymax = float(y0.max(initial=0.0))
-    s = np.empty_like(x0)
-    s[:-1] = ymax if ymax > 0 else 1.0
-    lo, hi = lam_bounds
-    width = hi - lo if math.isfinite(hi - lo) else 1.0
-    s[-1] = max(abs(float(x0[-1])), width)
-    if s[-1] <= 0:
-        s[-1] = 1.0
-    return s
 
 
 def _sign(v: float) -> int:

@@ -21,6 +21,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 
 @dataclass(frozen=True)
 class ArclengthOptions:
@@ -108,3 +110,30 @@ class ArclengthOptions:
         if ds_min > ds_max:
             raise ValueError(f"ds_min={ds_min:g} exceeds ds_max={ds_max:g}")
         return min(max(ds0, ds_min), ds_max), ds_min, ds_max
+
+
+def default_scale(x0: np.ndarray, lam_bounds: tuple[float, float]) -> np.ndarray:
+    """Per-unknown scales derived from the start (:mod:`continuation.arclength`, "Default scale").
+
+    Parameters
+    ----------
+    x0 : ndarray, shape (n+1,)
+        Starting point ``[y0, lam0]``.
+    lam_bounds : (float, float)
+        Parameter bounds.
+
+    Returns
+    -------
+    ndarray, shape (n+1,)
+        Positive scales.
+    """
+    y0 = np.abs(x0[:-1])
+    ymax = float(y0.max(initial=0.0))
+    s = np.empty_like(x0)
+    s[:-1] = ymax if ymax > 0 else 1.0
+    lo, hi = lam_bounds
+    width = hi - lo if math.isfinite(hi - lo) else 1.0
+    s[-1] = max(abs(float(x0[-1])), width)
+    if s[-1] <= 0:
+        s[-1] = 1.0
+    return s

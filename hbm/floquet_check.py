@@ -100,12 +100,13 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
     ValueError
         Support excitation or velocity-dependent laws (not handled here).
     """
-    from .timesim import _State, _one_period, kernel_model
+    from .time_state import TimeState, kernel_model
+    from .timesim import _one_period
     if case.excitation.base is not None:
         raise ValueError("the Floquet check of a balance point does not handle support excitation")
     w = 2.0 * np.pi * freq_hz
     packed = pack_elements(case.elements, case.n_dof)
-    state = _State(case, packed, w)
+    state = TimeState(case, packed, w)
     set_state(state, start_state(packed, basis, X, w, steps), packed.laws)
     opts = TimeSimOptions(steps=steps)
     periods = []

@@ -67,7 +67,7 @@ class ShootingResult:
 
 
 def state_vector(state) -> np.ndarray:
-    """``y = [q, v, a, S]`` of an integrator state (:class:`hbm.timesim._State`)."""
+    """``y = [q, v, a, S]`` of an integrator state (:class:`hbm.time_state.TimeState`)."""
     return np.concatenate([state.q, state.v, state.a, state.S])
 
 
@@ -187,7 +187,7 @@ def shoot(one_period, state, model, laws, w: float, tol: float,
     one_period : callable
         ``one_period(state, Y) -> q_history (N + 1, n)``: integrates one period in place,
         carrying ``Y`` (m, m) through every step.
-    state : hbm.timesim._State
+    state : hbm.time_state.TimeState
     model : tuple
         ``(M, C, K, F2, fixed, ybase)`` as the kernels take it (:mod:`hbm.time_kernels`).
     laws : tuple

@@ -80,69 +80,13 @@ import numpy as np
 
 from .budget import MEMORY_SHARE, machine_memory
 from .case import Case, CaseError
-from .time_kernels import element_forces, init_states
 from .time_march import march
-from .time_parts import Packed, pack_elements
+from .time_parts import pack_elements
 from .shooting import MAX_NEWTON, Balance, floquet_verdict, reduced_monodromy, shoot, start_sensitivity
 from .time_results import History, Run, TimeSimOptions, TimeSimResult
+from .time_state import TimeState, kernel_model
 
 __all__ = ["History", "Run", "TimeSimOptions", "TimeSimResult", "steady_state", "timesim", "transient"]
-
-
-
-def _support(case: Case):
-    """``fixed`` (n,) int64 flags of the support DOFs and ``ybase`` (n,) their amplitudes."""
-    n = case.n_dof
-    fixed = np.zeros(n, dtype=np.int64)
-    ybase = np.zeros(n)
-    if case.excitation.base is not None:
-        bd, ba = case.excitation.base
-        fixed[np.asarray(bd, dtype=int)] = 1
-        ybase[np.asarray(bd, dtype=int)] = np.asarray(ba, dtype=float)
-    return fixed, ybase
-
-
-class _State:
-    """The integrator state carried between chunks (and from the n run to the 2n run).
-
-    Start: at rest, except that support DOFs start at their prescribed position ``A`` (cosine
-    at ``t = 0``, velocity 0, acceleration ``-A w^2``) and the free DOFs at the quasi-static
-    position that follows it, ``K_ff q_f = -K_fs A`` with ``K`` including the elements'
-    stuck stiffness (a rigid translation when the supports carry the structure), so that the
-    run does not begin with a jolt.
-    """
-
-    def __init__(self, case: Case, packed: Packed, w: float = 0.0):
-        n = case.n_dof
-        K = case.model.K
-        fixed, ybase = _support(case)
-        fx = np.flatnonzero(fixed)
-        fr = np.flatnonzero(fixed == 0)
-        self.q = np.zeros(n)
-        self.v = np.zeros(n)
-        if fx.size:
-            self.q[fx] = ybase[fx]
-            Ks = K + sum((e.gather.T @ e.linear_stiffness() @ e.gather for e in case.elements),
-                         np.zeros_like(K))
-            self.q[fr] = -np.linalg.lstsq(Ks[np.ix_(fr, fr)], Ks[np.ix_(fr, fx)] @ ybase[fx], rcond=None)[0]
-        self.S = np.zeros(packed.n_states)
-        self.D = np.zeros(packed.n_tangents)
-        self.Dref = np.zeros(packed.n_parts)
-        init_states(packed.laws, self.q, self.v, self.S, self.D, self.Dref)
-        self.fnl = np.zeros(n)
-        element_forces(packed.laws, self.S, self.fnl)
-        # the acceleration that balances the equations at phase 0
-        self.a = Balance(kernel_model(case), packed.laws, w).acceleration(self.q, self.v, self.S)
-
-    def arrays(self) -> tuple:
-        """``(q, v, a, fnl, S, D, Dref)``, the kernels' state tuple (updated in place)."""
-        return self.q, self.v, self.a, self.fnl, self.S, self.D, self.Dref
-
-    def copy(self):
-        other = object.__new__(_State)
-        for k, val in self.__dict__.items():
-            setattr(other, k, val.copy())
-        return other
 
 
 def _check_supported(case: Case, switch_off_at=None) -> None:
@@ -183,14 +127,6 @@ def _amplitudes(case: Case, hist: History, N: int):
 
 
 _NO_SENS = np.zeros((0, 0))
-
-
-def kernel_model(case: Case) -> tuple:
-    """``(M, C, K, F2, fixed, ybase)``, the kernels' model tuple (:mod:`hbm.time_kernels`)."""
-    fixed, ybase = _support(case)
-    return (np.ascontiguousarray(case.model.M, dtype=float), np.ascontiguousarray(case.model.C, dtype=float),
-            np.ascontiguousarray(case.model.K, dtype=float),
-            np.ascontiguousarray(case.excitation.cos_sin, dtype=float), fixed, ybase)
 
 
 def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off, state,
@@ -342,7 +278,7 @@ def steady_state(case: Case, freq_hz: float, options: TimeSimOptions | None = No
     opts.validate()
     f = _check_freq(freq_hz)
     _check_supported(case)
-    state = _State(case, pack_elements(case.elements, case.n_dof), 2 * np.pi * f)
+    state = TimeState(case, pack_elements(case.elements, case.n_dof), 2 * np.pi * f)
     return _settle(case, f, opts, opts.steps, state, progress)
 
 
@@ -364,7 +300,7 @@ def transient(case: Case, freq_hz: float, periods: int, switch_off_at: float | N
     if switch_off_at is not None and not (switch_off_at >= 0 and math.isfinite(switch_off_at)):
         raise CaseError(f"switch-off time must be >= 0 s, got {switch_off_at!r}")
     _check_supported(case, switch_off_at)
-    state = _State(case, pack_elements(case.elements, case.n_dof), 2 * np.pi * f)
+    state = TimeState(case, pack_elements(case.elements, case.n_dof), 2 * np.pi * f)
     return _integrate(case, f, opts, opts.steps, int(periods), False, switch_off_at, state, progress)
 
 
@@ -404,7 +340,7 @@ def timesim(case: Case, freq_hz: float, options: TimeSimOptions | None = None,
     t0 = time.perf_counter()
     if periods is None:
         packed = pack_elements(case.elements, case.n_dof)
-        state = _State(case, packed, 2 * np.pi * f)
+        state = TimeState(case, packed, 2 * np.pi * f)
         coarse = _settle(case, f, opts, opts.steps, state, progress)
         fine = _settle(case, f, opts, 2 * opts.steps, state, progress, period_offset=coarse.periods)
         mode, conv, total = "steady", coarse.converged and fine.converged, coarse.periods + fine.periods

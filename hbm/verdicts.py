@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from .newton import newton
-from .stability import HillSystem, StabilityOptions, point_is_stable
+from .hill_system import HillSystem, point_is_stable
+from .stability import StabilityOptions
 from .stability_path import hill_margin, path_stability
 
 

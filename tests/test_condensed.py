@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from hbm.case import CaseError, case_from_dict, load_case
 from hbm.energy import energy_balance
-from hbm.model_io import write_op4
+from hbm.op4 import write_op4
 from hbm.response import choose_solver, frf, recover_outputs, solve_at
 
 ROOT = Path(__file__).resolve().parents[1]

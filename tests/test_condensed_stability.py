@@ -11,7 +11,7 @@ import pytest
 from hbm.case import case_from_dict
 from hbm.response import build_problem, frf
 from hbm.fourier import FourierBasis
-from hbm.stability import point_stability
+from hbm.hill_system import point_stability
 
 
 def chain(n):

@@ -11,7 +11,8 @@ import hbm
 from hbm.case import case_from_dict
 from hbm.modal_hill import modal_hill_system
 from hbm.response import solve_at
-from hbm.stability import HillSystem, hill_stability, point_stability
+from hbm.hill_system import HillSystem, point_stability
+from hbm.stability import hill_stability
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -74,7 +74,7 @@ def test_an_op4_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch):
     """The reader holds the text and the parsed entries (several times the file): a file that
     cannot fit is refused before reading, by its size (the machine's memory is shrunk here)."""
     import hbm.budget
-    from hbm.model_io import read_op4, write_op4
+    from hbm.op4 import read_op4, write_op4
     import numpy as np
     p = tmp_path / "m.op4"
     write_op4(p, {"KAA": np.eye(40), "MAA": np.eye(40)})

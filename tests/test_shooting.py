@@ -6,7 +6,8 @@ import pytest
 from hbm.case import case_from_dict
 from hbm.shooting import set_state, start_sensitivity, state_vector
 from hbm.time_parts import pack_elements
-from hbm.timesim import TimeSimOptions, _State, _integrate, _one_period, floquet, steady_state
+from hbm.time_state import TimeState
+from hbm.timesim import TimeSimOptions, _integrate, _one_period, floquet, steady_state
 
 
 def two_dof(elements, c=0.02):
@@ -45,7 +46,7 @@ def test_monodromy_matches_finite_differences(name):
     f, N = 0.2, 256
     opts = TimeSimOptions(steps=N)
     packed = pack_elements(case.elements, case.n_dof)
-    st = _State(case, packed, 2 * np.pi * f)
+    st = TimeState(case, packed, 2 * np.pi * f)
     _integrate(case, f, opts, N, 30, False, None, st, None)
     one = _one_period(case, f, opts, N, packed)
     y0 = state_vector(st)
@@ -76,7 +77,7 @@ def test_floquet_multipliers_of_a_damped_oscillator():
     m, k, c, f, N = 1.0, 1.0, 0.02, 0.2, 512
     case = sdof(c)
     packed = pack_elements(case.elements, case.n_dof)
-    st = _State(case, packed, 2 * np.pi * f)
+    st = TimeState(case, packed, 2 * np.pi * f)
     stable, big, mu = floquet(case, f, st, TimeSimOptions(steps=N), N)
     T = 1.0 / f
     w0 = np.sqrt(k / m)

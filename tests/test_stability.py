@@ -16,7 +16,8 @@ from hbm.fourier import FourierBasis
 from hbm.jumps import predict_jumps, stable_pieces
 from hbm.linear import LinearModel
 from hbm.dense_part import dense_balance
-from hbm.stability import fold_exponents, hill_matrix, hill_stability, point_stability, select_exponents
+from hbm.hill_system import point_stability
+from hbm.stability import fold_exponents, hill_matrix, hill_stability, select_exponents
 from hbm.transforms import make_transform
 
 from conftest import sdof_jenkins_case

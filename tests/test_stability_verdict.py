@@ -6,8 +6,8 @@ import pytest
 import hbm
 import hbm.stability as stab
 from hbm.dense_part import dense_balance
-from hbm.stability import (hill_is_stable, hill_stability, point_is_stable, point_stability,
-                           select_exponents, verdict_from_eigenvalues)
+from hbm.hill_system import point_is_stable, point_stability
+from hbm.stability import hill_is_stable, hill_stability, select_exponents, verdict_from_eigenvalues
 from hbm.transforms import make_transform
 
 from conftest import sdof_jenkins_case
