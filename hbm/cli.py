@@ -135,7 +135,7 @@ def _defaults_note(st) -> str:
 
 def cmd_frf(args) -> int:
     from .response import frf
-    from .report import write_frf
+    from .report import describe_folds, write_frf
     from .progress import FRFProgress, compile_notice
     case = load_case(args.case)
     _check_outdir(args.out)
@@ -175,7 +175,7 @@ def cmd_frf(args) -> int:
         for p in pk:
             print(f"  peak {name}: {p['amplitude']:.6g} at {p['freq_hz']:.6g} Hz")
     if summary["folds"]:
-        print("  folds at " + ", ".join(f"{f:.6g}" for f in summary["folds"]) + " Hz")
+        print("  " + describe_folds(summary["folds"], (st["fmin_hz"], st["fmax_hz"])))
     for name, jumps in (summary["jumps"] or {}).items():
         for way in ("up", "down"):
             for j in jumps[way]:

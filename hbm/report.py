@@ -46,6 +46,42 @@ def peaks(freq: np.ndarray, amp: np.ndarray) -> list:
     return [{"freq_hz": float(freq[i]), "amplitude": float(amp[i])} for i in idx]
 
 
+ZIGZAG_SHARE = 1e-3    # folds closer than this share of the window, one after another, chain
+ZIGZAG_MIN = 3         # a chain of this many folds or more is reported as one zigzag
+
+
+def describe_folds(folds, window) -> str:
+    """The folds of a path in one line: each fold's frequency, except that a chain of at least
+    :data:`ZIGZAG_MIN` folds, each within ``ZIGZAG_SHARE`` of the window from the one before,
+    is given as its range and count (a path that zigzags through many tiny turns, e.g. at the
+    top of an impact oscillator's peak, would otherwise print hundreds of numbers).
+
+    Parameters
+    ----------
+    folds : sequence of float
+        Fold frequencies in path order, Hz.
+    window : (float, float)
+        The FRF window, Hz.
+    """
+    tol = ZIGZAG_SHARE * abs(window[1] - window[0])
+    chains, cur = [], []
+    for f in folds:
+        if cur and abs(f - cur[-1]) > tol:
+            chains.append(cur)
+            cur = []
+        cur.append(float(f))
+    if cur:
+        chains.append(cur)
+    parts = []
+    for c in chains:
+        if len(c) < ZIGZAG_MIN:
+            parts.extend(f"{f:.6g}" for f in c)
+        else:
+            step = max(abs(b - a) for a, b in zip(c, c[1:]))
+            parts.append(f"{min(c):.6g}..{max(c):.6g} (a zigzag of {len(c)} folds, turns of up to {step:.2g} Hz)")
+    return "folds at " + ", ".join(parts) + " Hz"
+
+
 def format_csv(res) -> str:
     """The ``frf.csv`` text of ``res`` (header row, one row per point along the path)."""
     names = list(res.outputs)

@@ -26,3 +26,14 @@ def test_a_flank_reports_its_largest_value():
     pk = peaks(f, _two_modes(f))
     assert len(pk) == 1 and pk[0]["freq_hz"] == 8.0
     assert peaks(f[:0], f[:0]) == []
+
+
+def test_fold_line_names_separate_folds_and_collapses_a_zigzag():
+    from hbm.report import describe_folds
+    window = (0.0, 1.0)
+    zig = list(0.5 + 1e-4 * np.array([0, 1, 0.5, 1.5, 1, 2]))      # 6 turns, each 1e-4 apart
+    line = describe_folds([0.2, 0.21] + zig + [0.8], window)
+    assert line.startswith("folds at 0.2, 0.21, 0.5..0.5002 (a zigzag of 6 folds, turns of up to 0.0001 Hz), 0.8")
+    # two close folds (an S-shaped branch) are both named; so are folds further apart
+    assert describe_folds([0.3, 0.3005], window) == "folds at 0.3, 0.3005 Hz"
+    assert describe_folds([0.3, 0.302, 0.304], window) == "folds at 0.3, 0.302, 0.304 Hz"
