@@ -6,8 +6,8 @@ r"""Unilateral spring with a gap: a contact that pushes back only once it is clo
 
 for the coordinate ``u`` (a DOF, or a relative motion) and the gap ``g``: ``g > 0`` is open at
 rest, ``g < 0`` an interference (preloaded at rest, ``f = -k g``).  Memoryless: state
-``s = [f]``, input ``z = [u]``, parameters ``p = [k, g]``.  NLvib's 3-DOF example with a
-unilateral spring uses this law.
+``s = [f]``, input ``z = [u]``, parameters ``p = [k, g]``.  NLvib's ``unilateralSpring`` is this
+law (its examples 03 and 07).
 
 Describing function (first harmonic of ``f`` for ``u = a cos(theta)``, ``|g| < a``, with
 ``cos(beta) = g / a``): ``f_1 = (k a / pi) (beta - sin(beta) cos(beta))`` and the mean
