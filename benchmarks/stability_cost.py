@@ -1,0 +1,77 @@
+"""What Hill's stability verdicts cost beside the solve, on the cases the stability issue names.
+
+For each case: CPU time of the FRF without stability (``stability=False``) and with it
+(default: a verdict at every point), best of ``--repeat`` runs after a warm-up (compiled
+kernels cached), and the ratio ``(with - without) / without``.  Targets: at most 1 on the
+UPD rig, at most 0.5 on the 3-DOF two-Jenkins case.
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/stability_cost.py [--repeat 3]
+
+Writes benchmarks/results/stability_cost.csv.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import hbm                                      # noqa: E402
+from hbm.case import case_from_dict, load_case  # noqa: E402
+
+TARGETS = {"three_dof_two_jenkins": 0.5, "upd_rig": 1.0}
+
+
+def cases():
+    from time_vs_error import target_case
+    upd_like = tomllib.loads((ROOT / "benchmarks" / "upd_like.toml").read_text())
+    return {
+        "three_dof_two_jenkins": target_case,
+        "upd_like": lambda: case_from_dict(upd_like, str(ROOT / "benchmarks" / "upd_like.toml"), ROOT / "benchmarks"),
+        "upd_rig": lambda: load_case(ROOT / "rigs" / "upd_rig.toml"),
+        "blade_couple": lambda: load_case(ROOT / "rigs" / "blade_couple.toml"),
+    }
+
+
+def cpu(fun, repeat):
+    best, out = float("inf"), None
+    for _ in range(repeat):
+        t0 = time.process_time()
+        out = fun()
+        best = min(best, time.process_time() - t0)
+    return best, out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args(argv)
+    rows = []
+    for name, make in cases().items():
+        c = make()
+        hbm.frf(c)                                       # warm-up: compile, reduction cache
+        t0, r0 = cpu(lambda: hbm.frf(c, stability=False), args.repeat)
+        t1, r1 = cpu(lambda: hbm.frf(c), args.repeat)
+        ratio = (t1 - t0) / t0
+        target = TARGETS.get(name)
+        verdict = "" if target is None else (" (target <= %g: %s)" % (target, "met" if ratio <= target else "NOT met"))
+        print(f"{name}: {r0.freq_hz.size} points, solve {t0:.3f} s, with stability {t1:.3f} s: "
+              f"stability costs {ratio:.2f}x the solve{verdict}")
+        rows.append(dict(case=name, points=int(r0.freq_hz.size), solve_s=round(t0, 4), with_stability_s=round(t1, 4),
+                         ratio=round(ratio, 3), target="" if target is None else target))
+    out = ROOT / "benchmarks" / "results" / "stability_cost.csv"
+    with open(out, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
