@@ -219,7 +219,7 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     n = ev.R.size
     order = getattr(linear_solve, "order", "F")
     A = np.empty((n + 1, n + 1), order=order)   # refilled before every solve
-    B1 = np.empty((n + 1, 1), order="F")
+    B2 = np.empty((n + 1, 2), order="F")
     best = (np.inf, ev, 0)
     sqrt_tol = math.sqrt(tol)
     backtrack_below = max(1e3 * tol, sqrt_tol)
@@ -242,9 +242,9 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             break
         # when converged, the same matrix also gives the null vector of Js (the tangent,
         # module doc) from a second right-hand side
-        B = np.empty((n + 1, 2), order="F") if converged else B1
-        bordered_system(ev.Js, ev.R, a, rho, g, A, B)
-        sol = linear_solve(A, B)
+        # (both right-hand sides are always written: one layout of B, one compiled kernel)
+        bordered_system(ev.Js, ev.R, a, rho, g, A, B2)
+        sol = linear_solve(A, B2 if converged else B2[:, :1])
         d_max = math.nan if sol is None else inf_norm(sol[:, 0])
         if not math.isfinite(d_max):
             if converged:

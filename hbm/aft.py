@@ -133,11 +133,12 @@ class NonlinearForces:
         nn = self.n_nl
         F = np.zeros((nc, nn))
         if J_out is None:
-            J4 = np.zeros((nc, nn, nc, nn))
-        else:
-            s0, s1 = J_out.strides                   # a view on J_out's memory, whatever its strides
-            J4 = np.lib.stride_tricks.as_strided(J_out, (nc, nn, nc, nn), (nn * s0, s0, nn * s1, s1))
-            J4[...] = 0.0
+            # the layout of a Jacobian inside a bordered matrix (the continuation's), so that
+            # the kernels below are compiled once, not once per layout
+            J_out = np.empty((nc * nn, nc * nn + 1))[:, :-1]
+        s0, s1 = J_out.strides                       # a view on J_out's memory, whatever its strides
+        J4 = np.lib.stride_tricks.as_strided(J_out, (nc, nn, nc, nn), (nn * s0, s0, nn * s1, s1))
+        J4[...] = 0.0
         dFdw = np.zeros((nc, nn))
         N = self.basis.n_samples
         unclosed = 0
@@ -169,7 +170,7 @@ class NonlinearForces:
             T = np.matmul(G.T, dU)                                # (nc, nn, nc * nl)
             J4 += (T.reshape(nc * nn * nc, nl) @ G).reshape(nc, nn, nc, nn)
         self.last_unclosed = int(unclosed)
-        return F, (J4.reshape(nc * nn, nc * nn) if J_out is None else J_out), dFdw
+        return F, J_out, dFdw
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:
         """Forces only, (n_coef, n_nl): the march runs with a single zero seed."""

@@ -25,7 +25,7 @@ def compile_notice() -> None:
     cached = any(True for d in ("hbm", "elements", "continuation")
                  for _ in (root / d).rglob("__pycache__/*.nbi"))
     if not cached:
-        sys.stderr.write("hbm: first run: compiling the numerical kernels (about 20 s, cached afterwards)\n")
+        sys.stderr.write("hbm: first run: compiling the numerical kernels (10-20 s, cached afterwards)\n")
         sys.stderr.flush()
 
 

@@ -98,9 +98,9 @@ class HarmonicBalance:
         dRdw : ndarray, shape (n_u,)
         """
         nu = self.n_unknowns
-        J, dRw = np.empty((nu, nu)), np.empty(nu)
-        R = self._evaluate(X, float(w), J, dRw)
-        return R, J, dRw
+        A = np.empty((nu, nu + 1))         # the layout of __call__'s: one compiled variant of each kernel
+        R = self._evaluate(X, float(w), A[:, :nu], A[:, nu])
+        return R, A[:, :nu], A[:, nu]
 
     def __call__(self, x: np.ndarray):
         """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]``
