@@ -24,7 +24,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import hbm
-from hbm.case import case_from_dict
+from hbm.interface.case import case_from_dict
 from elements import Brush
 from elements.hertz import hertz_contact
 from elements.loops import symmetric_damper_function

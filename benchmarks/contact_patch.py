@@ -82,9 +82,9 @@ def _best(fn, n=3):
 
 def measure(n_c: int, H: int, max_points: int) -> dict:
     """One case in this process (see module doc); returns a row of :data:`FIELDS`."""
-    from hbm.case import case_from_dict
-    from hbm.fourier import FourierBasis
-    from hbm.response import build_problem, frf, resolve_settings
+    from hbm.interface.case import case_from_dict
+    from hbm.balance.fourier import FourierBasis
+    from hbm.analyses.response import build_problem, frf, resolve_settings
     case = case_from_dict(case_dict(n_c, H, max_points), path="contact_patch")
     h, N, lo, hi, tr = resolve_settings(case, None, None, None, None, None)
     problem, _ = build_problem(case, FourierBasis(h, N), tr)

@@ -6,7 +6,7 @@ Run by hand (never part of the tests)::
 
 For every element type with a small representative case, the FRF is traced with
 ``hbm.frf`` for H on a ladder (1, 3, 5, 7, 9, 11, 15, 21) and for two sample counts,
-``N = default_samples(H)`` (:func:`hbm.fourier.default_samples`: a power of two >= 8 H and
+``N = default_samples(H)`` (:func:`hbm.balance.fourier.default_samples`: a power of two >= 8 H and
 >= 64, factor 1) and twice that (factor 2), and compared with a converged HBM reference of
 the same case (``REF``: H = 31, N = 2048, a dense path):
 
@@ -63,8 +63,8 @@ sys.path.insert(0, str(HERE))
 from time_vs_error import ROOT, RESULTS, cpu, refined_peak, sdof_case, couple_case, inclined_case  # noqa: E402
 
 import hbm  # noqa: E402
-from hbm.case import case_from_dict  # noqa: E402
-from hbm.fourier import default_samples  # noqa: E402
+from hbm.interface.case import case_from_dict  # noqa: E402
+from hbm.balance.fourier import default_samples  # noqa: E402
 from elements import ELEMENTS  # noqa: E402
 from continuation import ArclengthOptions  # noqa: E402
 

@@ -1,10 +1,10 @@
 """Hill's stability verdicts against Floquet multipliers of the time-domain period map.
 
 For every ``--every``-th point of each case's FRF (and every point Hill calls unstable), the
-balance point starts a shooting run of the time integrator (:mod:`hbm.floquet_check`):
+balance point starts a shooting run of the time integrator (:mod:`hbm.timedomain.floquet_check`):
 Newton on the period map finds the periodic time solution next to it, stable or not, and
 the eigenvalues of its monodromy matrix decide its stability.  ``hbm.frf`` already replaces
-Hill's unstable verdicts by Floquet's on small non-smooth models (:func:`hbm.floquet_check.
+Hill's unstable verdicts by Floquet's on small non-smooth models (:func:`hbm.timedomain.floquet_check.
 confirm_unstable`); those points are listed as Hill's disagreements.  A verdict is compared when
 shooting converged; ``distance`` says how far (relative) the time solution lies from the
 balance point (large: the balance point is inaccurate at its H, or another branch).
@@ -30,8 +30,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import hbm                                     # noqa: E402
-from hbm.case import case_from_dict, load_case  # noqa: E402
-from hbm.floquet_check import check_point      # noqa: E402
+from hbm.interface.case import case_from_dict, load_case  # noqa: E402
+from hbm.timedomain.floquet_check import check_point      # noqa: E402
 
 
 def duffing():
@@ -89,7 +89,7 @@ def study(name, case, every, steps):
 def from_rest(name, case, res, freqs, steps):
     """``hbm timesim`` from rest at ``freqs``: the FRF point it settles on (the crossing of the
     path at that frequency with the nearest amplitude) must not be called unstable."""
-    from hbm.timesim import TimeSimOptions, steady_state
+    from hbm.timedomain.timesim import TimeSimOptions, steady_state
     out = next(iter(case.analysis.outputs))
     f, a = res.freq_hz, res.outputs[out].h1
     bad = 0

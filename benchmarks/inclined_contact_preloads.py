@@ -35,7 +35,7 @@ def run(n0: float):
     with open(RIG, "rb") as fh:
         data = copy.deepcopy(tomllib.load(fh))
     data["element"][0]["normal_preload"] = n0
-    case = hbm.case.case_from_dict(data, str(RIG), RIG.parent)
+    case = hbm.interface.case.case_from_dict(data, str(RIG), RIG.parent)
     return hbm.frf(case)
 
 

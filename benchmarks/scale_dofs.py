@@ -23,9 +23,9 @@ import time
 import tomllib
 from pathlib import Path
 
-from hbm.case import case_from_dict
-from hbm.fourier import FourierBasis
-from hbm.response import build_problem, frf
+from hbm.interface.case import case_from_dict
+from hbm.balance.fourier import FourierBasis
+from hbm.analyses.response import build_problem, frf
 
 HERE = Path(__file__).resolve().parent
 ELEMENTS_PER_BLADE = (10, 40, 100, 400, 1000, 4000, 8000)

@@ -23,7 +23,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import hbm                                      # noqa: E402
-from hbm.case import case_from_dict, load_case  # noqa: E402
+from hbm.interface.case import case_from_dict, load_case  # noqa: E402
 
 TARGETS = {"three_dof_two_jenkins": 0.5, "upd_rig": 1.0}
 

@@ -40,10 +40,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import hbm  # noqa: E402
-from hbm.case import case_from_dict  # noqa: E402
-from hbm.fourier import FourierBasis  # noqa: E402
-from hbm.response import build_problem, solve_at, output_amplitudes  # noqa: E402
-from hbm.transforms import TRANSFORMS  # noqa: E402
+from hbm.interface.case import case_from_dict  # noqa: E402
+from hbm.balance.fourier import FourierBasis  # noqa: E402
+from hbm.analyses.response import build_problem, solve_at, output_amplitudes  # noqa: E402
+from hbm.balance.transforms import TRANSFORMS  # noqa: E402
 from continuation import ArclengthOptions  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
@@ -128,7 +128,7 @@ def curve_error(res, ref, name):
 
 def time_domain_cost(case, f_peak, a_ref, name, ladder):
     """Per-frequency timesim cost and peak error at each steps-per-period of the ladder."""
-    from hbm.timesim import TimeSimOptions, steady_state
+    from hbm.timedomain.timesim import TimeSimOptions, steady_state
     out = []
     for steps in ladder:
         opts = TimeSimOptions(steps=steps, tol=1e-9, max_periods=20000)
@@ -247,7 +247,7 @@ def plain_jenkins_march(u, dz, kt, fs, start):
 
 def section_numba(quick):
     from elements import Jenkins
-    from hbm.aft import _seeds
+    from hbm.balance.aft import _seeds
     print("\n== 3. numba march against plain NumPy/Python (Jenkins, seeds included)")
     print(f"  {'H':>3} {'N':>5} {'numba us':>9} {'numpy us':>9} {'speed-up':>9}")
     out = []

@@ -1,4 +1,4 @@
-"""Rewrite docs/case-reference.md (from hbm/schema.py, the key lists the loader validates
+"""Rewrite docs/case-reference.md (from hbm/interface/schema.py, the key lists the loader validates
 against) and docs/cli.md (from the command-line parser itself), so neither can drift.
 
 ``python docs/make_reference.py`` rewrites both; ``--check`` only compares and exits 1 on a
@@ -14,7 +14,7 @@ DOCS = pathlib.Path(__file__).resolve().parent
 def cli_reference() -> str:
     """Markdown of ``hbm --help`` and each command's ``--help``."""
     os.environ["COLUMNS"] = "100"          # argparse wraps to the terminal: fix the width
-    from hbm.cli import build_parser
+    from hbm.interface.cli import build_parser
     parser = build_parser()
     sub = next(a for a in parser._actions if a.dest == "command")
     lines = ["# Command-line reference", "",
@@ -27,7 +27,7 @@ def cli_reference() -> str:
 
 
 def main(check: bool) -> int:
-    from hbm.schema import reference
+    from hbm.interface.schema import reference
     stale = []
     for name, text in (("case-reference.md", reference()), ("cli.md", cli_reference())):
         path = DOCS / name

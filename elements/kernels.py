@@ -27,7 +27,7 @@ from .laws.registry import _law_init, _law_step
 
 
 # One dispatch text, two compilations: a called kernel for the time integrator
-# (hbm.timesim, ``kind`` varies per element), and an inlined one for the marches, where a
+# (hbm.timedomain.timesim, ``kind`` varies per element), and an inlined one for the marches, where a
 # constant ``kind`` (elements.law_march.march_of) lets numba prune the other laws' branches
 # before typing, so that only the marched law is compiled, inlined into the sample loop.
 law_step = nb.njit(cache=True)(_law_step)

@@ -138,7 +138,7 @@ class WedgeDamper(Element):
     # --- case hooks --------------------------------------------------------------------
     @classmethod
     def internal_dofs(cls, spec, where="wedge_damper"):
-        """Damper DOFs this element adds to the model (hook of :mod:`hbm.case`).
+        """Damper DOFs this element adds to the model (hook of :mod:`hbm.interface.case`).
 
         Returns
         -------
@@ -168,7 +168,7 @@ class WedgeDamper(Element):
             dn = f"{name}.{s}"
             if dof_index is None or dn not in dof_index:
                 raise ValueError(f"{where}: damper DOF {dn!r} is not in the model (wedge_damper adds "
-                                 f"its DOFs when the case is loaded by hbm.case)")
+                                 f"its DOFs when the case is loaded by hbm.interface.case)")
             damper.append(int(dof_index[dn]))
         used = {i for pl in platform for c in pl for i in c}
         if used & set(damper):

@@ -7,26 +7,26 @@
 >>> res.table()                     # the frf.csv columns as arrays (res.to_frame() with pandas)
 >>> loops = hbm.contact_loops(case, res, res.nearest(32.0))   # forces over one period
 """
-from .case import Case, CaseError, case_from_dict, load_case
+from hbm.interface.case import Case, CaseError, case_from_dict, load_case
 
 __version__ = "0.2.0"
 
 
 def frf(case, harmonics=None, samples=None, fmin=None, fmax=None, **kwargs):
-    """Trace the FRF of a case; see :func:`hbm.response.frf`."""
-    from .response import frf as _frf
+    """Trace the FRF of a case; see :func:`hbm.analyses.response.frf`."""
+    from hbm.analyses.response import frf as _frf
     return _frf(case, harmonics=harmonics, samples=samples, fmin=fmin, fmax=fmax, **kwargs)
 
 
 def timesim(case, freq_hz, options=None, **kwargs):
-    """Time-domain reference at one frequency; see :func:`hbm.timesim.timesim`."""
-    from .timesim import timesim as _timesim
+    """Time-domain reference at one frequency; see :func:`hbm.timedomain.timesim.timesim`."""
+    from hbm.timedomain.timesim import timesim as _timesim
     return _timesim(case, freq_hz, options, **kwargs)
 
 
 def contact_loops(case, result, point):
-    """Element forces and hysteresis loops at one FRF point; see :func:`hbm.element_loops.contact_loops`."""
-    from .element_loops import contact_loops as _loops
+    """Element forces and hysteresis loops at one FRF point; see :func:`hbm.balance.element_loops.contact_loops`."""
+    from hbm.balance.element_loops import contact_loops as _loops
     return _loops(case, result, point)
 
 

@@ -1,6 +1,6 @@
 """``python -m hbm`` is the ``hbm`` command."""
 import sys
 
-from .cli import main
+from hbm.interface.cli import main
 
 sys.exit(main())

@@ -26,8 +26,8 @@ import matplotlib                                                      # noqa: E
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt                                        # noqa: E402
 
-from hbm.case import case_from_dict                                    # noqa: E402
-from hbm.timesim import TimeSimOptions, transient                      # noqa: E402
+from hbm.interface.case import case_from_dict                                    # noqa: E402
+from hbm.timedomain.timesim import TimeSimOptions, transient                      # noqa: E402
 from rigs.studies.blade_couple_sweep import (ContactLaw, Analysis, load_rig, with_contacts,  # noqa: E402
                                              frf_of, peak_row, optimum, plot, write_csv,
                                              runaway_peak)

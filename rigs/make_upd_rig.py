@@ -30,7 +30,7 @@ RIGS = Path(__file__).resolve().parent
 ROOT = RIGS.parent
 sys.path.insert(0, str(ROOT))
 
-from hbm.case import load_case                                          # noqa: E402
+from hbm.interface.case import load_case                                          # noqa: E402
 
 OUT = RIGS / "upd_rig"
 CASE = RIGS / "upd_rig.toml"

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from hbm.case import case_from_dict
+from hbm.interface.case import case_from_dict
 
 
 def sdof_jenkins_case(m=1.0, k=1.0, c=0.02, kt=1.0, fs=0.3, F=1.0, f_hz=(0.1, 0.3), H=7, N=128,

@@ -3,8 +3,8 @@ error is within the tolerance; the answer then is, against converged references.
 import numpy as np
 import pytest
 
-from hbm.adaptive import frf_to_tolerance, next_harmonics
-from hbm.response import solve_at
+from hbm.analyses.adaptive import frf_to_tolerance, next_harmonics
+from hbm.analyses.response import solve_at
 from test_truncation import three_dof
 
 

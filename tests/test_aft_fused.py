@@ -1,4 +1,4 @@
-"""The compiled AFT of law elements (hbm/aft_kernel.py) against the generic path, its linear shortcut and
+"""The compiled AFT of law elements (hbm/balance/aft_kernel.py) against the generic path, its linear shortcut and
 the closed-form start rule."""
 import numpy as np
 import pytest
@@ -6,11 +6,11 @@ import pytest
 from elements import Jenkins, Cubic, Friction3D
 from elements.coulomb import CoulombStickSlip, CoulombRegularised
 from elements.law_march import principal_reversal_index, linear_shortcut
-from hbm.aft import NonlinearForces
-from hbm.aft_kernel import aft_law
-from hbm.case import case_from_dict
-from hbm.fourier import FourierBasis
-from hbm.transforms import make_transform
+from hbm.balance.aft import NonlinearForces
+from hbm.balance.aft_kernel import aft_law
+from hbm.interface.case import case_from_dict
+from hbm.balance.fourier import FourierBasis
+from hbm.balance.transforms import make_transform
 
 
 def both_paths(el, basis, X, w):

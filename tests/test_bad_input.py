@@ -1,7 +1,7 @@
 """Bad input, table-driven: every malformed case file or command line gives exactly one line
 on stderr naming the problem and exit status 2, never a traceback.
 
-Most rows run ``hbm.cli.main`` in-process (fast); a few run ``python -m hbm`` in a subprocess.
+Most rows run ``hbm.interface.cli.main`` in-process (fast); a few run ``python -m hbm`` in a subprocess.
 Each row is ``(id, case text or a special maker, extra CLI args, needle)``; the needle must
 appear (case-insensitive) in the one stderr line.
 """
@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from hbm.cli import main
+from hbm.interface.cli import main
 
 BASE = """\
 name = "bad-input base"
@@ -230,7 +230,7 @@ def test_the_table_is_big_enough():
 
 def test_base_case_is_valid():
     import tomllib
-    from hbm.case import case_from_dict
+    from hbm.interface.case import case_from_dict
     case = case_from_dict(tomllib.loads(BASE))
     assert case.n_dof == 2 and len(case.elements) == 2
 
@@ -294,7 +294,7 @@ def test_bad_input_in_a_subprocess(tmp_path, make, args, needle):
 
 
 def test_misspelled_names_get_a_suggestion():
-    from hbm.case import CaseError, case_from_dict
+    from hbm.interface.case import CaseError, case_from_dict
     raw = {"model": {"mass": [1.0, 1.0], "stiffness": [1.0, 1.0], "damping": [0.1, 0.1],
                      "dof_names": ["blade.x", "blade.y"]},
            "excitation": {"dofs": ["blade.xx"], "amplitude": [1.0]},

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.case import case_from_dict, CaseError
+from hbm.interface.case import case_from_dict, CaseError
 
 
 def base_case(fs=None, kt=50.0, c=0.5, H=5):

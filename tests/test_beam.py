@@ -4,8 +4,8 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from hbm.linear import LinearModel
-from hbm.reduction import reduce_model
+from hbm.model.linear import LinearModel
+from hbm.model.reduction import reduce_model
 from hbm.builders import BUILDERS
 from hbm.builders.beam import Section, build_beam_model, rigid_offset_rows
 

@@ -9,7 +9,7 @@ import pytest
 from elements import ELEMENTS, Brush, Friction3D
 from elements.hertz import hertz_contact, winkler_load
 from elements.loops import describing_function, dissipated_energy, harmonic_motion, loop_forces
-from hbm.fourier import FourierBasis
+from hbm.balance.fourier import FourierBasis
 
 BASIS = FourierBasis(np.array([0, 1, 2, 3]), 64)
 ALL = ("t1", "t2", "n", "rx", "ry")
@@ -298,7 +298,7 @@ def test_rig_damper_acts_on_out_of_phase_mode():
     import tomllib
     from pathlib import Path
     import hbm
-    from hbm.case import case_from_dict
+    from hbm.interface.case import case_from_dict
     path = Path(__file__).resolve().parents[1] / "rigs" / "beam_damper_beam.toml"
     data = tomllib.loads(path.read_text())
     for el in data["element"]:
@@ -375,10 +375,10 @@ def test_timesim_on_the_brush_rig_agrees_with_the_balance():
     within 1 % on the tips (measured 0.3 and 0.4 % at 512 steps per period, 0.8 % at 256)."""
     import tomllib
     from pathlib import Path
-    from hbm.case import case_from_dict
-    from hbm.problem_setup import output_amplitudes
-    from hbm.response import solve_at
-    from hbm.timesim import TimeSimOptions, steady_state
+    from hbm.interface.case import case_from_dict
+    from hbm.analyses.problem_setup import output_amplitudes
+    from hbm.analyses.response import solve_at
+    from hbm.timedomain.timesim import TimeSimOptions, steady_state
     path = Path(__file__).resolve().parents[1] / "rigs" / "beam_damper_beam.toml"
     data = tomllib.loads(path.read_text())
     for el in data["element"]:

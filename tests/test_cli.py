@@ -32,7 +32,7 @@ def test_frf_writes_csv_png_summary(tmp_path):
 
 
 def test_progress_follows_the_window_not_the_path():
-    from hbm.progress import FRFProgress
+    from hbm.interface.progress import FRFProgress
     bar = FRFProgress(20.0, 50.0)
     for n, f in enumerate((20.0, 35.0, 32.0, 41.0, 50.0)):     # a fold turns back at 35 Hz
         bar(n, f)
@@ -42,7 +42,7 @@ def test_progress_follows_the_window_not_the_path():
 
 
 def test_version_and_rigs(capsys):
-    from hbm.cli import main
+    from hbm.interface.cli import main
     import hbm
     with pytest.raises(SystemExit) as e:
         main(["--version"])

@@ -14,10 +14,10 @@ import scipy.io
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from hbm.case import CaseError, case_from_dict, load_case
-from hbm.energy import energy_balance
-from hbm.op4 import write_op4
-from hbm.response import choose_solver, frf, recover_outputs, solve_at
+from hbm.interface.case import CaseError, case_from_dict, load_case
+from hbm.balance.energy import energy_balance
+from hbm.model.op4 import write_op4
+from hbm.analyses.response import choose_solver, frf, recover_outputs, solve_at
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,14 +1,14 @@
 """The condensed residual (all harmonics at once, compiled linear part) against the per-harmonic
-blocks of :class:`hbm.condensed_model.CondensedModel`, finite differences and its own energy check."""
+blocks of :class:`hbm.model.condensed_model.CondensedModel`, finite differences and its own energy check."""
 import numpy as np
 import pytest
 
-from hbm.case import case_from_dict
-from hbm.condensed import CondensedLinear, condensed_balance
-from hbm.condensed_kernels import _invert
-from hbm.fourier import FourierBasis
-from hbm.real_blocks import apply_blocks
-from hbm.response import build_problem
+from hbm.interface.case import case_from_dict
+from hbm.balance.condensed import CondensedLinear, condensed_balance
+from hbm.balance.condensed_kernels import _invert
+from hbm.balance.fourier import FourierBasis
+from hbm.model.real_blocks import apply_blocks
+from hbm.analyses.response import build_problem
 
 
 def chain(n=12, seed=0):
@@ -172,8 +172,8 @@ def test_compiled_inverse():
 
 @pytest.mark.parametrize("damping", ["modal", "matrix"])
 def test_receptance_stack_matches_single_frequency(damping):
-    from hbm.condensed_kernels import modal_receptances
-    from hbm.reduction import receptance_stack
+    from hbm.balance.condensed_kernels import modal_receptances
+    from hbm.model.reduction import receptance_stack
     p = problem(damping, 5)
     r = p.linear.reduced
     phi = r.phi[:4]
@@ -205,7 +205,7 @@ def test_linear_strategies_give_the_same_numbers(damping, strategy):
     the compiled Gauss-Jordan path: residual, Jacobians, outputs and energy balance."""
     case = _case(damping, 5)
     basis = FourierBasis(case.analysis.harmonics, case.analysis.time_samples)
-    # 5 modes reach 5.4 Hz: they cover frequencies to 2.7 Hz (hbm.mode_cover), the test's 1.9 Hz
+    # 5 modes reach 5.4 Hz: they cover frequencies to 2.7 Hz (hbm.model.mode_cover), the test's 1.9 Hz
     ref, _ = build_problem(case, basis, "auto", fmax_hz=2.5)
     assert ref.linear._builder.strategy == "compiled" and ref.linear.reduced.n_modes == 5
     p = _rebuilt(case, basis, ref, strategy)
@@ -234,11 +234,11 @@ def test_woodbury_needs_a_positive_definite_residual_flexibility():
     ref, _ = build_problem(case, basis, "auto")
     with pytest.raises(ValueError, match="positive definite residual flexibility"):
         _rebuilt(case, basis, ref, "woodbury")
-    from hbm.condensed_linear import LinearBuilder
+    from hbm.balance.condensed_linear import LinearBuilder
     b = ref.linear._builder
     auto = LinearBuilder(ref.linear.reduced, b.phi, b.R, 4, 1, b.hs, b.rows, b.i1, "auto")
     assert auto.strategy == "compiled"                 # 4 contacts: below the Woodbury threshold
-    import hbm.condensed_linear as cl
+    import hbm.balance.condensed_linear as cl
     old, cl.WOODBURY_MIN_CONTACTS = cl.WOODBURY_MIN_CONTACTS, 1
     try:
         assert LinearBuilder(ref.linear.reduced, b.phi, b.R, 4, 1, b.hs, b.rows, b.i1, "auto").strategy == "dense"

@@ -8,10 +8,10 @@ the full model's path, unstable branch included.
 import numpy as np
 import pytest
 
-from hbm.case import case_from_dict
-from hbm.response import build_problem, frf
-from hbm.fourier import FourierBasis
-from hbm.hill_system import point_stability
+from hbm.interface.case import case_from_dict
+from hbm.analyses.response import build_problem, frf
+from hbm.balance.fourier import FourierBasis
+from hbm.analyses.hill_system import point_stability
 
 
 def chain(n):
@@ -83,11 +83,11 @@ def test_walk_with_skips_finds_the_duffing_chain_verdicts(monkeypatch):
     """The walk against every point's spectrum on the continuation's own points.  The points
     placed on peaks and between long steps are left out here: one of them (0.0803 Hz) is a
     one-point unstable island, narrower than the skip, which a walk may miss by design."""
-    import hbm.curve_fill
-    import hbm.peak_refine
-    from hbm.stability import StabilityOptions
-    monkeypatch.setattr(hbm.curve_fill, "MAX_SHARE", 10.0)
-    monkeypatch.setattr(hbm.peak_refine, "ROUNDS", 0)
+    import hbm.analyses.curve_fill
+    import hbm.analyses.peak_refine
+    from hbm.analyses.stability import StabilityOptions
+    monkeypatch.setattr(hbm.analyses.curve_fill, "MAX_SHARE", 10.0)
+    monkeypatch.setattr(hbm.analyses.peak_refine, "ROUNDS", 0)
     every = frf(duffing_chain("full"))
     assert every.settings["stability_spectra"] == every.freq_hz.size     # default: every point
     walk = frf(duffing_chain("full"), stability_options=StabilityOptions(max_skip=3))
@@ -96,7 +96,7 @@ def test_walk_with_skips_finds_the_duffing_chain_verdicts(monkeypatch):
 
 
 def test_walk_probes_folds_and_finds_a_drifting_crossing():
-    from hbm.stability_path import path_stability
+    from hbm.analyses.stability_path import path_stability
     # margin drifts linearly through zero between points 40 and 41 of a monotone path
     n = 100
     freq = np.linspace(1.0, 2.0, n)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from hbm.case import case_from_dict, CaseError
+from hbm.interface.case import case_from_dict, CaseError
 
 
 def case(dofs):

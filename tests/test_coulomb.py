@@ -4,7 +4,7 @@ import pytest
 
 from elements import ELEMENTS, CoulombStickSlip, CoulombRegularised
 from elements.kernels import march, law_step
-from hbm.fourier import FourierBasis
+from hbm.balance.fourier import FourierBasis
 
 KT, NLOAD, MUS, MUK = 10.0, 1.0, 0.5, 0.3      # break loose at 0.5, slide at 0.3
 

@@ -5,7 +5,7 @@ import pathlib
 import numpy as np
 
 import hbm
-from hbm.curve_fill import MAX_SHARE
+from hbm.analyses.curve_fill import MAX_SHARE
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

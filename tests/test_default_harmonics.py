@@ -5,9 +5,9 @@ import pytest
 
 import hbm
 from elements import ELEMENTS, Element, Jenkins, Cubic
-from hbm.case import case_from_dict, element_defaults, CaseError, LINEAR_DEFAULT
-from hbm.fourier import default_samples
-from hbm.report import summary_dict
+from hbm.interface.case import case_from_dict, element_defaults, CaseError, LINEAR_DEFAULT
+from hbm.balance.fourier import default_samples
+from hbm.interface.report import summary_dict
 
 JENKINS = {"type": "jenkins", "dofs": [0], "kt": 2.0, "slip_force": 0.3}
 CUBIC = {"type": "cubic", "dofs": [1], "k3": 0.01}

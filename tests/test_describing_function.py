@@ -8,9 +8,9 @@ For ``u = A cos(theta)``, ``kt A > fs``: with ``cos(theta*) = 1 - 2 fs/(kt A)``,
 import numpy as np
 
 from elements import Jenkins
-from hbm.aft import NonlinearForces
-from hbm.fourier import FourierBasis
-from hbm.transforms import make_transform
+from hbm.balance.aft import NonlinearForces
+from hbm.balance.fourier import FourierBasis
+from hbm.balance.transforms import make_transform
 
 
 def closed_form(A, kt, fs):

@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from hbm.case import ANALYSIS_KEYS, EXCITATION_KEYS, MODEL_KEYS, TOP_KEYS
+from hbm.interface.case import ANALYSIS_KEYS, EXCITATION_KEYS, MODEL_KEYS, TOP_KEYS
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -32,7 +32,7 @@ def test_reference_lists_every_key_the_loader_accepts():
 
 def test_undocumented_element_key_stops_the_reference(monkeypatch):
     from elements import ELEMENTS
-    from hbm import schema
+    from hbm.interface import schema
     monkeypatch.setattr(ELEMENTS["jenkins"], "keys", ELEMENTS["jenkins"].keys + ("brand_new",))
     with pytest.raises(RuntimeError, match="brand_new"):
         schema.reference()

@@ -4,7 +4,7 @@ import pytest
 from scipy.optimize import brentq
 
 import hbm
-from hbm.case import case_from_dict
+from hbm.interface.case import case_from_dict
 
 M, K, C, K3, F = 1.0, 1.0, 0.02, 0.4, 0.1
 

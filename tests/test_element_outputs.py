@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.case import CaseError, case_from_dict
-from hbm.report import write_frf
+from hbm.interface.case import CaseError, case_from_dict
+from hbm.interface.report import write_frf
 from elements import Jenkins, CoulombStickSlip, CoulombRegularised, Friction3D, ELEMENTS
 
 C30, S30 = np.cos(np.pi / 6), np.sin(np.pi / 6)

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.case import CaseError, case_from_dict
-from hbm.condensed import condensed_balance
-from hbm.energy import energy_balance
-from hbm.fourier import FourierBasis
-from hbm.response import build_problem, solve_at
-from hbm.timesim import TimeSimOptions, timesim
+from hbm.interface.case import CaseError, case_from_dict
+from hbm.balance.condensed import condensed_balance
+from hbm.balance.energy import energy_balance
+from hbm.balance.fourier import FourierBasis
+from hbm.analyses.response import build_problem, solve_at
+from hbm.timedomain.timesim import TimeSimOptions, timesim
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

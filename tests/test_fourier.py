@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from hbm.fourier import FourierBasis, parse_harmonics, min_samples
+from hbm.balance.fourier import FourierBasis, parse_harmonics, min_samples
 
 
 @pytest.mark.parametrize("h", [[0, 1, 2, 3], [1, 3, 5, 7], [1, 2], [0, 1, 4]])

@@ -40,7 +40,7 @@ def test_energy_balance_every_point_sdof_and_3dof():
         "analysis": {"harmonics": 5, "time_samples": 64, "frequency_hz": [0.05, 0.35],
                      "outputs": {"a": 0, "b": 2}},
     }
-    res = hbm.frf(hbm.case.case_from_dict(data))
+    res = hbm.frf(hbm.interface.case.case_from_dict(data))
     assert res.ok, res.message
     assert np.all(res.energy_error < 1e-8), res.energy_error.max()
     # friction dissipates: the response is below the undamped-by-friction free linear peak
@@ -48,9 +48,9 @@ def test_energy_balance_every_point_sdof_and_3dof():
 
 
 def test_linear_resonances_of_both_limits_and_the_step_limit():
-    from hbm.resonances import ResonanceStepLimit, linear_resonances
-    from hbm.response import _step_limit, build_problem
-    from hbm.fourier import FourierBasis
+    from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
+    from hbm.analyses.response import _step_limit, build_problem
+    from hbm.balance.fourier import FourierBasis
     case = sdof_jenkins_case(m=1.0, k=4e4, c=2.0, kt=2.667e4, fs=2.0, f_hz=(20, 50), H=3, N=32)
     problem, _ = build_problem(case, FourierBasis([1, 2, 3], 32), "auto")
     lim = _step_limit(problem, case, (2 * np.pi * 20, 2 * np.pi * 50))

@@ -6,7 +6,7 @@ import pytest
 from elements import ELEMENTS, Friction3D, Jenkins
 from elements.kernels import law_step
 from elements.closure import march_newton
-from hbm.fourier import FourierBasis
+from hbm.balance.fourier import FourierBasis
 
 KT, KN, MU, N0 = 1.0, 2.0, 0.5, 1.0       # mu N0 / kt = 0.5
 

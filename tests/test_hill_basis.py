@@ -1,5 +1,5 @@
 """Hill's problem on every harmonic and with the modes above the harmonics static
-(hbm.stability.HillSystem, hbm.modal_hill): the two causes of spurious instabilities found
+(hbm.analyses.stability.HillSystem, hbm.analyses.modal_hill): the two causes of spurious instabilities found
 on the shipped cases, each against a reference that does not depend on them."""
 import tomllib
 from pathlib import Path
@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.case import case_from_dict
-from hbm.modal_hill import modal_hill_system
-from hbm.response import solve_at
-from hbm.hill_system import HillSystem, point_stability
-from hbm.stability import hill_stability
+from hbm.interface.case import case_from_dict
+from hbm.analyses.modal_hill import modal_hill_system
+from hbm.analyses.response import solve_at
+from hbm.analyses.hill_system import HillSystem, point_stability
+from hbm.analyses.stability import hill_stability
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -5,7 +5,7 @@ import shutil
 
 import pytest
 
-from hbm.cli import main
+from hbm.interface.cli import main
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SDOF = str(ROOT / "rigs" / "sdof_jenkins.toml")
@@ -73,12 +73,12 @@ def test_corrupt_reduction_cache_is_recomputed(tmp_path, capsys):
 def test_an_op4_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch):
     """The reader holds the text and the parsed entries (several times the file): a file that
     cannot fit is refused before reading, by its size (the machine's memory is shrunk here)."""
-    import hbm.budget
-    from hbm.op4 import read_op4, write_op4
+    import hbm.analyses.budget
+    from hbm.model.op4 import read_op4, write_op4
     import numpy as np
     p = tmp_path / "m.op4"
     write_op4(p, {"KAA": np.eye(40), "MAA": np.eye(40)})
     assert set(read_op4(p)) == {"KAA", "MAA"}
-    monkeypatch.setattr(hbm.budget, "machine_memory", lambda: 2.0 * p.stat().st_size)
+    monkeypatch.setattr(hbm.analyses.budget, "machine_memory", lambda: 2.0 * p.stat().st_size)
     with pytest.raises(ValueError, match="needs about .* GB to read"):
         read_op4(p)

@@ -54,12 +54,12 @@ def test_one_residual_class_and_no_branching_on_the_linear_part():
 
 
 def test_both_solvers_build_the_same_residual_class():
-    from hbm.case import case_from_dict
-    from hbm.condensed import CondensedLinear
-    from hbm.dense_part import DenseLinear
-    from hbm.fourier import FourierBasis
-    from hbm.problem_setup import build_problem
-    from hbm.residual import HarmonicBalance
+    from hbm.interface.case import case_from_dict
+    from hbm.balance.condensed import CondensedLinear
+    from hbm.balance.dense_part import DenseLinear
+    from hbm.balance.fourier import FourierBasis
+    from hbm.analyses.problem_setup import build_problem
+    from hbm.balance.residual import HarmonicBalance
     kinds = {}
     for solver in ("full", "condensed"):
         case = case_from_dict({

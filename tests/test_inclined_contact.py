@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.energy import energy_balance
-from hbm.dense_part import dense_balance
-from hbm.transforms import make_transform
+from hbm.balance.energy import energy_balance
+from hbm.balance.dense_part import dense_balance
+from hbm.balance.transforms import make_transform
 
 RIG = Path(__file__).resolve().parents[1] / "rigs" / "inclined_contact.toml"
 PRELOADS = {"low": 1.0, "medium": 5.0, "high": 20.0}
@@ -21,7 +21,7 @@ def rig_case(n0):
         data = tomllib.load(fh)
     data = copy.deepcopy(data)
     data["element"][0]["normal_preload"] = n0
-    return hbm.case.case_from_dict(data, str(RIG), RIG.parent)
+    return hbm.interface.case.case_from_dict(data, str(RIG), RIG.parent)
 
 
 @pytest.fixture(scope="module")

@@ -14,9 +14,9 @@ import tomllib
 
 import pytest
 
-from hbm.case import CaseError, case_from_dict
-from hbm.fourier import FourierBasis
-from hbm.response import build_problem, resolve_settings
+from hbm.interface.case import CaseError, case_from_dict
+from hbm.balance.fourier import FourierBasis
+from hbm.analyses.response import build_problem, resolve_settings
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 RIGS = ["sdof_jenkins", "blade_pair_wedge", "inclined_contact", "blade_pair_travelling"]

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 
 from elements import Jenkins, Cubic
-from hbm.aft import NonlinearForces
-from hbm.fourier import FourierBasis
-from hbm.linear import LinearModel
-from hbm.dense_part import dense_balance
-from hbm.transforms import make_transform
+from hbm.balance.aft import NonlinearForces
+from hbm.balance.fourier import FourierBasis
+from hbm.model.linear import LinearModel
+from hbm.balance.dense_part import dense_balance
+from hbm.balance.transforms import make_transform
 
 
 def fd_check(fun, x0, eps=1e-7):
@@ -64,7 +64,7 @@ def test_residual_jacobian_wrt_X_and_w(rng):
 
 
 def test_dense_assembly_equals_block_assembly(rng):
-    """The one-call dense path (stored Z0, Z1, Z2; hbm.dense_kernels) gives the numbers of the
+    """The one-call dense path (stored Z0, Z1, Z2; hbm.balance.dense_kernels) gives the numbers of the
     harmonic-block path, for a model with and without elements."""
     M = np.diag([1.0, 2.0, 1.0])
     K = np.array([[2.0, -1, 0], [-1, 2, -1], [0, -1, 2]])

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.case import CaseError
+from hbm.interface.case import CaseError
 
 N = 100
 K = 2 * np.eye(N) - np.eye(N, k=1) - np.eye(N, k=-1)

@@ -38,7 +38,7 @@ def test_frf_with_kept_lu_equals_direct_path(monkeypatch):
     """The FRF of a 4-contact condensed chain (H = 3, 28 unknowns, 0.5-0.8 Hz) traced with the kept LU
     (forced on below its size threshold) lands on the direct path's points to 1e-8."""
     from test_condensed_residual import _case
-    from hbm.response import frf
+    from hbm.analyses.response import frf
     case = _case("modal", 5)
     ref = frf(case, stability=False, fmax=0.8)
     monkeypatch.setattr(arclength, "REUSE_MIN_SIZE", 1)

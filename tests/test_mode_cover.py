@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import hbm
-import hbm.mode_cover as mc
+import hbm.model.mode_cover as mc
 
 N_DOF = 300
 

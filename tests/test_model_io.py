@@ -6,8 +6,8 @@ import pytest
 import scipy.io
 import scipy.sparse as sp
 
-from hbm.model_io import load_model_file, read_matrix_market, read_npz
-from hbm.op4 import read_op4, read_op4_model, write_op4
+from hbm.model.model_io import load_model_file, read_matrix_market, read_npz
+from hbm.model.op4 import read_op4, read_op4_model, write_op4
 from hbm.builders.beam import build_beam_model
 
 DATA = Path(__file__).parent / "data"

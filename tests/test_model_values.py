@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import scipy.io
 
-from hbm.case import CaseError, case_from_dict
-from hbm.model_io import load_model_file
+from hbm.interface.case import CaseError, case_from_dict
+from hbm.model.model_io import load_model_file
 
 M = np.eye(2)
 K = np.array([[2.0, -1.0], [-1.0, 2.0]])

@@ -7,8 +7,8 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 import hbm
-from hbm.peak_refine import _vertex
-from hbm.response import output_amplitudes, recover_outputs, solve_at
+from hbm.analyses.peak_refine import _vertex
+from hbm.analyses.response import output_amplitudes, recover_outputs, solve_at
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from hbm.fourier import FourierBasis
-from hbm.linear import LinearModel, harmonic_blocks
-from hbm.condensed_model import condense
-from hbm.real_blocks import apply_blocks, real_block
-from hbm.reduction import reduce_model, reduce_linear_model
+from hbm.balance.fourier import FourierBasis
+from hbm.model.linear import LinearModel, harmonic_blocks
+from hbm.model.condensed_model import condense
+from hbm.model.real_blocks import apply_blocks, real_block
+from hbm.model.reduction import reduce_model, reduce_linear_model
 
 
 def chain(n=30, seed=0):

@@ -1,7 +1,7 @@
 """Peaks reported by ``hbm frf``: resonances by prominence, not every local maximum."""
 import numpy as np
 
-from hbm.report import peaks
+from hbm.interface.report import peaks
 
 
 def _two_modes(f):
@@ -29,7 +29,7 @@ def test_a_flank_reports_its_largest_value():
 
 
 def test_fold_line_names_separate_folds_and_collapses_a_zigzag():
-    from hbm.report import describe_folds
+    from hbm.interface.report import describe_folds
     window = (0.0, 1.0)
     zig = list(0.5 + 1e-4 * np.array([0, 1, 0.5, 1.5, 1, 2]))      # 6 turns, each 1e-4 apart
     line = describe_folds([0.2, 0.21] + zig + [0.8], window)

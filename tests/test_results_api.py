@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.energy import energy_balance
-from hbm.response import build_problem
+from hbm.balance.energy import energy_balance
+from hbm.analyses.response import build_problem
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

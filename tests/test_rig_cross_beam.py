@@ -69,7 +69,7 @@ def test_damper_spectra_odd_superharmonics(regimes):
 def test_three_regimes_by_hbm(regimes):
     # the steady periodic solutions at the gross-slip and stick loads (the stick-slip point
     # takes ~15 s and is in rigs/studies/cross_beam_study.py)
-    import hbm.response as response
+    import hbm.analyses.response as response
     for N, lo, hi in ((2.85, 0.97, 1.0), (22.8, 0.0, 0.0)):
         case = regimes[N][0]
         X, basis, _ = response.solve_at(case, st.FREQ_HZ)
@@ -97,11 +97,11 @@ def test_energy_density_optimum_in_stick_slip():
 def test_frf_below_breakaway_passes_the_energy_check():
     """C = 0 and both dampers stuck below breakaway: no work is done at all, every work of the
     balance is zero up to round-off.  The energy error is judged against the most work the
-    excitation could do at that motion (hbm.energy); against the zero works it read 1.0 and
+    excitation could do at that motion (hbm.balance.energy); against the zero works it read 1.0 and
     the FRF stopped at its first point."""
     import hbm
-    from hbm.energy import energy_balance
-    from hbm.response import build_problem
+    from hbm.balance.energy import energy_balance
+    from hbm.analyses.response import build_problem
     case = hbm.load_case(ROOT / "rigs" / "cross_beam.toml")
     res = hbm.frf(case, fmax=34.0, stability=False)
     assert res.ok and res.freq_hz.size >= 5 and res.energy_error.max() < 1e-10, res.message

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import hbm                                                               # noqa: E402
-from hbm.case import case_from_dict                                      # noqa: E402
+from hbm.interface.case import case_from_dict                                      # noqa: E402
 from rigs.make_upd_rig import linear_modes, mode_peaks, read_frf, SPLIT_HZ  # noqa: E402
 
 CASE = ROOT / "rigs" / "upd_rig.toml"

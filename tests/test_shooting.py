@@ -3,11 +3,11 @@ multipliers against the closed form, and the steady state by shooting."""
 import numpy as np
 import pytest
 
-from hbm.case import case_from_dict
-from hbm.shooting import set_state, start_sensitivity, state_vector
-from hbm.time_parts import pack_elements
-from hbm.time_state import TimeState
-from hbm.timesim import TimeSimOptions, _integrate, _one_period, floquet, steady_state
+from hbm.interface.case import case_from_dict
+from hbm.timedomain.shooting import set_state, start_sensitivity, state_vector
+from hbm.timedomain.time_parts import pack_elements
+from hbm.timedomain.time_state import TimeState
+from hbm.timedomain.timesim import TimeSimOptions, _integrate, _one_period, floquet, steady_state
 
 
 def two_dof(elements, c=0.02):
@@ -144,7 +144,7 @@ def test_floquet_check_agrees_with_hill_on_the_duffing_branches():
     converges next to it (unstable ones too) and its multipliers give Hill's verdict: the
     middle branch unstable (|mu| up to 1.9), the others stable."""
     import hbm
-    from hbm.floquet_check import check_point
+    from hbm.timedomain.floquet_check import check_point
     case = duffing()
     res = hbm.frf(case)
     unstable = np.flatnonzero(~res.stable)
@@ -161,7 +161,7 @@ def test_floquet_confirmation_keeps_true_instability_and_clears_a_false_flag():
     Hill's unstable points by Floquet: the Duffing middle branch stays unstable; a stable point
     flagged unstable by hand is cleared and reported."""
     import hbm
-    from hbm.floquet_check import confirm_unstable
+    from hbm.timedomain.floquet_check import confirm_unstable
     case = duffing([{"type": "jenkins", "dofs": [0], "kt": 0.2, "slip_force": 1e6}])
     res = hbm.frf(case)
     n_bad = int((~res.stable).sum())

@@ -11,14 +11,14 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.cli import main
-from hbm.fourier import FourierBasis
-from hbm.jumps import predict_jumps, stable_pieces
-from hbm.linear import LinearModel
-from hbm.dense_part import dense_balance
-from hbm.hill_system import point_stability
-from hbm.stability import fold_exponents, hill_matrix, hill_stability, select_exponents
-from hbm.transforms import make_transform
+from hbm.interface.cli import main
+from hbm.balance.fourier import FourierBasis
+from hbm.analyses.jumps import predict_jumps, stable_pieces
+from hbm.model.linear import LinearModel
+from hbm.balance.dense_part import dense_balance
+from hbm.analyses.hill_system import point_stability
+from hbm.analyses.stability import fold_exponents, hill_matrix, hill_stability, select_exponents
+from hbm.balance.transforms import make_transform
 
 from conftest import sdof_jenkins_case
 from test_duffing import C, F, K, K3, M, duffing_case

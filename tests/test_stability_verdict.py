@@ -1,14 +1,14 @@
-"""The eigenvector-free stability verdict (hbm.stability.verdict_from_eigenvalues,
+"""The eigenvector-free stability verdict (hbm.analyses.stability.verdict_from_eigenvalues,
 hill_is_stable, point_is_stable) against the full Hill filter."""
 import numpy as np
 import pytest
 
 import hbm
-import hbm.stability as stab
-from hbm.dense_part import dense_balance
-from hbm.hill_system import point_is_stable, point_stability
-from hbm.stability import hill_is_stable, hill_stability, select_exponents, verdict_from_eigenvalues
-from hbm.transforms import make_transform
+import hbm.analyses.stability as stab
+from hbm.balance.dense_part import dense_balance
+from hbm.analyses.hill_system import point_is_stable, point_stability
+from hbm.analyses.stability import hill_is_stable, hill_stability, select_exponents, verdict_from_eigenvalues
+from hbm.balance.transforms import make_transform
 
 from conftest import sdof_jenkins_case
 from test_duffing import duffing_case
@@ -124,7 +124,7 @@ def test_undecided_verdict_falls_back_to_eigenvectors(monkeypatch):
 
 
 def test_non_finite_jacobian_raises_like_hill_stability():
-    from hbm.fourier import FourierBasis
+    from hbm.balance.fourier import FourierBasis
     basis = FourierBasis([1, 2], 8)
     J = np.eye(4)
     J[1, 2] = np.nan

@@ -5,7 +5,7 @@ import pathlib
 import numpy as np
 
 import hbm
-from hbm.report import format_csv
+from hbm.interface.report import format_csv
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

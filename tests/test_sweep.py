@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hbm.case import CaseError, load_case
-from hbm.casekeys import get_key, set_key
-from hbm.cli import main
-from hbm.sweep import FRFOverrides, SweepOptions, parse_assignment, parse_values, sweep
+from hbm.interface.case import CaseError, load_case
+from hbm.interface.casekeys import get_key, set_key
+from hbm.interface.cli import main
+from hbm.analyses.sweep import FRFOverrides, SweepOptions, parse_assignment, parse_values, sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 RIG = ROOT / "rigs" / "sdof_jenkins.toml"     # m=1, k=4e4, c=2, kt=2.667e4, F=5
@@ -197,15 +197,15 @@ def test_force_ratio_needs_a_force_key(tmp_path, capsys):
 
 
 def test_failed_runs_are_recorded_and_the_sweep_goes_on(tmp_path, monkeypatch):
-    import hbm.response
-    real = hbm.response.frf
+    import hbm.analyses.response
+    real = hbm.analyses.response.frf
 
     def flaky(case, **kw):
         if case.elements[0].slip_force == 4.0:
             raise FloatingPointError("simulated solver blow-up")
         return real(case, **kw)
 
-    monkeypatch.setattr(hbm.response, "frf", flaky)
+    monkeypatch.setattr(hbm.analyses.response, "frf", flaky)
     res = sweep(str(RIG), "element.0.slip_force", [0.5, 4.0, 30.0], tmp_path, overrides=H3, options=SERIAL)
     assert [r["status"] for r in res.rows] == ["finished", "failed", "finished"] and not res.ok
     rows = read_csv(tmp_path / "summary.csv")
@@ -260,8 +260,8 @@ def test_resume_recomputes_when_the_model_file_changed(tmp_path):
 
 
 def test_a_folder_in_use_is_refused_and_a_stale_lock_taken_over(tmp_path):
-    from hbm.atomic import LOCK_NAME
-    from hbm.case import CaseError
+    from hbm.interface.atomic import LOCK_NAME
+    from hbm.interface.case import CaseError
     out = tmp_path / "out"
     out.mkdir()
     other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])

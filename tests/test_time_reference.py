@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from hbm.response import solve_at, output_amplitudes
+from hbm.analyses.response import solve_at, output_amplitudes
 from conftest import sdof_jenkins_case
 from timeref import jenkins_sdof_steady
 

@@ -1,4 +1,4 @@
-"""The time-domain reference (``hbm.timesim``): accuracy, step convergence, transient, CLI."""
+"""The time-domain reference (``hbm.timedomain.timesim``): accuracy, step convergence, transient, CLI."""
 import csv
 import subprocess
 import sys
@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hbm.case import case_from_dict
-from hbm.timesim import TimeSimOptions, steady_state, timesim, transient
+from hbm.interface.case import case_from_dict
+from hbm.timedomain.timesim import TimeSimOptions, steady_state, timesim, transient
 from conftest import sdof_jenkins_case
 from timeref import jenkins_sdof_steady
 
@@ -168,7 +168,7 @@ def test_hbm_matches_time_domain_at_H15():
     cont = pytest.importorskip("continuation")
     if not hasattr(cont, "Arclength"):
         pytest.skip("continuation package not merged yet")
-    from hbm.response import solve_at, output_amplitudes
+    from hbm.analyses.response import solve_at, output_amplitudes
     case = sdof_jenkins_case(**JENKINS)
     for f_hz in (0.12, 0.16, 0.2):
         X, basis, _ = solve_at(case, f_hz, harmonics=15, samples=512)
@@ -180,7 +180,7 @@ def test_hbm_matches_time_domain_at_H15():
 
 
 def test_bad_options_raise_case_error():
-    from hbm.case import CaseError
+    from hbm.interface.case import CaseError
     case = sdof_jenkins_case(**JENKINS)
     for call in (lambda: timesim(case, -1.0), lambda: timesim(case, 0.0),
                  lambda: timesim(case, 0.1, TimeSimOptions(steps=4)),

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import hbm
-import hbm.response
-from hbm.case import case_from_dict, CaseError
-from hbm.timesim import TimeSimOptions, timesim, transient
+import hbm.analyses.response
+from hbm.interface.case import case_from_dict, CaseError
+from hbm.timedomain.timesim import TimeSimOptions, timesim, transient
 
 A = 1e-3
 
@@ -65,9 +65,9 @@ def test_friction_against_moving_support_matches_hbm():
     # Jenkins element between the mass and the moving support, slipping part of the period
     case = base_case(fs=0.08, H=31)
     f_hz = 3.0
-    X, basis, problem = hbm.response.solve_at(case, f_hz, harmonics=31, samples=512)
+    X, basis, problem = hbm.analyses.response.solve_at(case, f_hz, harmonics=31, samples=512)
     g = case.analysis.outputs["rel"]
-    h1_hbm, _ = hbm.response.output_amplitudes(basis, X @ g)
+    h1_hbm, _ = hbm.analyses.response.output_amplitudes(basis, X @ g)
     res = timesim(case, f_hz, TimeSimOptions(steps=512, tol=1e-10))
     assert res.converged
     # the element did slip (its force reached the slip limit), so this is not a linear check

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.response import solve_at
-from hbm.truncation import richer_basis
+from hbm.analyses.response import solve_at
+from hbm.analyses.truncation import richer_basis
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -64,7 +64,7 @@ def test_the_five_percent_point_is_flagged():
 
 
 def test_richer_basis_keeps_the_pattern():
-    from hbm.fourier import FourierBasis
+    from hbm.balance.fourier import FourierBasis
     odd = richer_basis(FourierBasis([1, 3, 5], 32))
     assert list(odd.harmonics) == [1, 3, 5, 7, 9, 11] and odd.n_samples >= 128
     full = richer_basis(FourierBasis([0, 1, 2, 3], 16))

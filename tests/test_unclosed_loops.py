@@ -2,8 +2,8 @@
 used silently: the FRF's settings count the points and carry a warning."""
 import numpy as np
 
-from hbm.case import load_case
-from hbm.response import frf
+from hbm.interface.case import load_case
+from hbm.analyses.response import frf
 
 
 def _case(max_passes=None):

@@ -10,13 +10,13 @@ import hbm
 from elements import ELEMENTS, UnilateralSpring
 from elements.law_march import linear_shortcut
 from elements.laws.registry import UNILATERAL
-from hbm.aft import NonlinearForces
-from hbm.case import CaseError, case_from_dict
-from hbm.dense_part import dense_balance
-from hbm.fourier import FourierBasis
-from hbm.linear import LinearModel
-from hbm.timesim import TimeSimOptions, steady_state
-from hbm.transforms import make_transform
+from hbm.balance.aft import NonlinearForces
+from hbm.interface.case import CaseError, case_from_dict
+from hbm.balance.dense_part import dense_balance
+from hbm.balance.fourier import FourierBasis
+from hbm.model.linear import LinearModel
+from hbm.timedomain.timesim import TimeSimOptions, steady_state
+from hbm.balance.transforms import make_transform
 
 K, GAP = 3.0, 0.4
 

@@ -8,13 +8,13 @@ import pytest
 from scipy.optimize import fsolve
 
 import hbm
-from hbm.case import CaseError, case_from_dict
-from hbm.fourier import FourierBasis
-from hbm.newton import newton
-from hbm.postprocess import element_summaries
-from hbm.dense_part import dense_balance
-from hbm.response import _unknown_scale
-from hbm.transforms import make_transform
+from hbm.interface.case import CaseError, case_from_dict
+from hbm.balance.fourier import FourierBasis
+from hbm.balance.newton import newton
+from hbm.analyses.postprocess import element_summaries
+from hbm.balance.dense_part import dense_balance
+from hbm.analyses.response import _unknown_scale
+from hbm.balance.transforms import make_transform
 from elements.wedge_statics import static_normal_loads
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -361,7 +361,7 @@ def test_rig_blade_pair_wedge_runs_with_energy_balance():
     assert res.ok, res.message
     assert res.freq_hz.size > 30
     assert np.all(res.energy_error < 1e-8), res.energy_error.max()
-    from hbm.report import summary_dict
+    from hbm.interface.report import summary_dict
     st = summary_dict(case, res)["elements"][0]["static_state"]
     assert st["normal_load_left"] == pytest.approx(50.0 / (2 * (math.cos(math.pi / 4) * 1.3)))
     # two resonances: IP near the free blades (~100 Hz), OoP stiffened by the wedge (> 120 Hz)
@@ -375,8 +375,8 @@ def test_time_domain_steps_the_wedge_through_its_flank_contacts():
     # the wedge was packed for time stepping as one friction3d law with no parameters (its
     # forces came out of uninitialised memory); it now steps through its flank contacts and
     # agrees with the harmonic balance (H = 7) well within the time reference's error estimate
-    from hbm.response import output_amplitudes, recover_outputs, solve_at
-    from hbm.timesim import TimeSimOptions, timesim
+    from hbm.analyses.response import output_amplitudes, recover_outputs, solve_at
+    from hbm.timedomain.timesim import TimeSimOptions, timesim
     case = hbm.load_case(ROOT / "rigs" / "blade_pair_wedge.toml")
     f = 100.0
     X, basis, problem = solve_at(case, f, harmonics=7, samples=128)

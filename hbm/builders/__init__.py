@@ -1,5 +1,5 @@
 """Builders that turn a few readable parameters into a linear model (``BUILDERS[key](**keys)``)."""
-from .beam import build_beam_model
+from hbm.builders.beam import build_beam_model
 
 BUILDERS = {"beam": build_beam_model}
 

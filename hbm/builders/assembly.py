@@ -62,7 +62,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .beam import DENSE_MAX_DOF, build_beam_model
+from hbm.builders.beam import DENSE_MAX_DOF, build_beam_model
 
 BEAM_KEYS = ("name", "length", "n_elements", "E", "rho", "nu", "width", "height", "area", "Iy",
              "Iz", "J", "clamp", "origin", "axis", "up", "lumped_mass", "points", "point_masses")

@@ -27,12 +27,12 @@ local axes.  Clamped nodes' DOFs are removed.
 A rigid offset (a platform point ``p`` rigidly attached to node ``n`` at offset ``r``,
 small rotations) moves by ``u_p = u_n + theta_n x r = [I, -[r]_x] [u_n; theta_n]``; the
 three rows over the model's DOFs are the point's translation coordinates, which contact
-elements and :func:`hbm.condensed_model.condense` use as gather rows.  A point mass ``m`` at such a
+elements and :func:`hbm.model.condensed_model.condense` use as gather rows.  A point mass ``m`` at such a
 point adds ``m G_p^T G_p`` to ``M``.
 
 The matrices are dense ``ndarray`` up to ``DENSE_MAX_DOF`` free DOFs (dense eigen-solves are
 fast there) and ``scipy.sparse`` CSR above (use the shift-invert path of
-:func:`hbm.reduction.reduce_model`).
+:func:`hbm.model.reduction.reduce_model`).
 """
 from __future__ import annotations
 

@@ -40,7 +40,7 @@ if str(HERE.parents[1]) not in sys.path:        # run as a script from anywhere
     sys.path.insert(0, str(HERE.parents[1]))
 
 import hbm                                       # noqa: E402
-from hbm.case import CaseError, case_from_dict   # noqa: E402
+from hbm.interface.case import CaseError, case_from_dict   # noqa: E402
 
 LAWS = ("jenkins", "arctan", "linear")
 

@@ -2,12 +2,12 @@ r"""Cross beam with stick-slip dampers (seed 000): the three regimes and the ene
 
 Regimes (f = 20 N at 240 rad/s): N = 2.85 N gross slip, 17.1 N stick-slip, 22.8 N pure stick.
 
-- Time domain, as in the paper: integration from rest (``hbm.timesim`` transient mode,
+- Time domain, as in the paper: integration from rest (``hbm.timedomain.timesim`` transient mode,
   Newmark with a slight HHT ``alpha = -0.05`` that only damps the contact-penalty ringing
   near 700 Hz; no structural damping) over ``PERIODS`` periods; the last ``SHOW`` periods
   are analysed: friction force against time and against the relative (sliding) velocity,
   spectra of the damper and blade-tip motion.
-- Harmonic balance at the same points (``hbm.response.solve_at``, odd harmonics 1..31):
+- Harmonic balance at the same points (``hbm.analyses.response.solve_at``, odd harmonics 1..31):
   the steady periodic solution; slip fraction from the element's marched forces.
 
 Slip fraction: the fraction of samples at which the contact slides, i.e. its force is
@@ -35,9 +35,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-import hbm.response as response                        # noqa: E402
-from hbm.case import case_from_dict                    # noqa: E402
-from hbm.timesim import TimeSimOptions, transient      # noqa: E402
+import hbm.analyses.response as response                        # noqa: E402
+from hbm.interface.case import case_from_dict                    # noqa: E402
+from hbm.timedomain.timesim import TimeSimOptions, transient      # noqa: E402
 from rigs.studies.stick import coulomb_sliding         # noqa: E402
 
 CASE = ROOT / "rigs" / "cross_beam.toml"

@@ -1,7 +1,7 @@
 r"""Railcar friction wedge (seed 004): stick-slip near 30 Hz and the rise of the relative motion
 beyond about 35 Hz, side-frame shaken as ``A cos(W t)`` from 20 to 40 Hz.
 
-1. Time histories (``hbm.timesim``, HHT alpha = -0.3 to damp the contact-penalty ringing) at
+1. Time histories (``hbm.timedomain.timesim``, HHT alpha = -0.3 to damp the contact-penalty ringing) at
    the paper's frequencies 20, 25, 28.5, 29, 29.5, 30 and 40 Hz: relative bolster/side-frame
    displacement and velocity, phase portrait, spectrum; the stick intervals (all four
    contacts stuck, longer than ``MIN_STICK``) with their type A/B.
@@ -27,10 +27,10 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 import hbm                                          # noqa: E402
-import hbm.response as response                     # noqa: E402
-from hbm.fourier import FourierBasis, basis_matrix  # noqa: E402
-from hbm.newton import newton                       # noqa: E402
-from hbm.timesim import TimeSimOptions, steady_state  # noqa: E402
+import hbm.analyses.response as response                     # noqa: E402
+from hbm.balance.fourier import FourierBasis, basis_matrix  # noqa: E402
+from hbm.balance.newton import newton                       # noqa: E402
+from hbm.timedomain.timesim import TimeSimOptions, steady_state  # noqa: E402
 from rigs.studies.stick import friction3d_stuck, stick_intervals, peak_to_peak  # noqa: E402
 
 CASE = ROOT / "rigs" / "railcar_wedge.toml"

@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hbm.case import case_from_dict
-from hbm.response import frf
+from hbm.interface.case import case_from_dict
+from hbm.analyses.response import frf
 
 ENERGY_TOL = 1e-8
 PEAK_FRACTION = 0.9

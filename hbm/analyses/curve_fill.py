@@ -1,0 +1,92 @@
+r"""Points between long continuation steps, so the drawn curve follows the true one.
+
+On flat stretches the continuation takes long steps (the corrector converges easily there),
+and the piecewise-linear curve cuts across what lies between: an anti-resonance between two
+modes drawn as a V of two chords.  Wherever two consecutive points of one traced segment lie
+more than ``MAX_SHARE`` of the window apart in frequency (and the frequency is monotone
+between them), points are solved at evenly spaced frequencies in between by Newton at fixed
+frequency, each started from the linear interpolation of its neighbours' coefficients, and
+inserted in path order.  A solve that fails, or lands farther from its guess than
+``BRANCH_SHARE`` of the step (on another branch that coexists at that frequency, between
+two folds), inserts nothing (the chord stays).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hbm.balance.energy import energy_balance
+from hbm.balance.newton import newton
+
+MAX_SHARE = 1.0 / 60.0
+BRANCH_SHARE = 0.5      # a solved point farther than this share of the step from its guess is refused
+
+
+def solve_near(problem, guess, w, radius, xscale, r_scale, tol=1e-10):
+    """Newton at fixed ``w`` from ``guess`` (n_coef, n): ``(X, iterations)``, or None when it
+    fails or lands farther than ``radius`` from the guess (another branch coexisting at ``w``)."""
+    fun = lambda u: problem.residual(problem.expand(u), w)[:2]
+    res = newton(fun, problem.unknowns(guess), scale=xscale, r_scale=r_scale, tol=tol)
+    if not res.converged:
+        return None
+    X = problem.expand(res.x)
+    return (X, res.iterations) if np.linalg.norm(X - guess) <= radius else None
+
+
+def insert_point(problem, pts, segments, k, at, X, w, its, Y) -> None:
+    """Insert the solved point ``(X, w)`` with outputs ``Y`` at path index ``at`` of segment
+    ``k`` (its energy error and loop closure taken here); later segments shift by one."""
+    err = energy_balance(problem, X, w).relative_error
+    for name, v in (("X", X), ("w", w), ("Y", Y), ("its", its), ("err", err),
+                    ("unclosed", problem.nl.last_unclosed)):
+        getattr(pts, name).insert(at, v)
+    segments[k][1] += 1
+    for seg in segments[k + 1:]:
+        seg[0] += 1
+        seg[1] += 1
+
+
+def fill_long_steps(problem, pts, segments, outputs_of, window, xscale, r_scale) -> int:
+    """Insert points so that no step inside a segment spans more than ``MAX_SHARE`` of the
+    window (module doc); returns how many were inserted.
+
+    Parameters
+    ----------
+    problem
+        The FRF's problem.
+    pts : hbm.analyses.response._Path
+        Traced points, changed in place.
+    segments : list of [int, int]
+        ``[start, end)`` of each traced segment, shifted by every insertion.
+    outputs_of : callable
+        ``(X, w) -> Y``, the outputs of a point.
+    window : (float, float)
+        ``(w_lo, w_hi)``, rad/s.
+    xscale : ndarray
+    r_scale : float
+    """
+    limit = MAX_SHARE * (window[1] - window[0])
+    added = 0
+    for k in range(len(segments)):
+        i = segments[k][0]
+        while i < segments[k][1] - 1:
+            w0, w1 = pts.w[i], pts.w[i + 1]
+            n_new = math.ceil(abs(w1 - w0) / limit) - 1
+            if n_new <= 0:
+                i += 1
+                continue
+            X0, X1 = pts.X[i], pts.X[i + 1]
+            radius = BRANCH_SHARE * np.linalg.norm(X1 - X0)
+            new = []
+            for j in range(1, n_new + 1):
+                t = j / (n_new + 1)
+                w = w0 + t * (w1 - w0)
+                got = solve_near(problem, (1 - t) * X0 + t * X1, w, radius, xscale, r_scale)
+                if got is not None:
+                    new.append((got[0], w, got[1]))
+            for off, (X, w, its) in enumerate(new, start=1):
+                insert_point(problem, pts, segments, k, i + off, X, w, its, outputs_of(X, w))
+            added += len(new)
+            i += len(new) + 1
+    return added

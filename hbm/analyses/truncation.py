@@ -1,0 +1,92 @@
+r"""Error of the harmonic truncation at every FRF point, by one Newton step in a richer basis.
+
+A point :math:`X` solves the balance on the harmonics :math:`\mathcal H` (highest :math:`H`)
+with :math:`N` samples.  Embedded in the richer basis :math:`\mathcal H'` (the same pattern
+up to :math:`H' = 2H + 1`, :math:`N' \ge 4N`) with zero coefficients on the new harmonics,
+its residual :math:`R'(X)` holds what the truncation left out: the element forces on the
+harmonics above :math:`H` and the aliasing of :math:`N` samples.  One Newton step
+
+.. math::
+
+    J'(X)\, \delta = -R'(X)
+
+gives the richer solution to first order, :math:`X' \approx X + \delta`, and the estimated
+relative error of each output's first harmonic is
+
+.. math::
+
+    e = \frac{\big|\, |y_1(X + \delta)| - |y_1(X)| \,\big|}{|y_1(X + \delta)|}.
+
+It costs one residual, Jacobian and LU of the richer problem per point, so the FRF computes
+it when that problem has at most ``MAX_UNKNOWNS`` unknowns (its settings say so otherwise).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from hbm.balance.fourier import FourierBasis
+
+MAX_UNKNOWNS = 2000
+WARN_ERROR = 1e-2        # a point estimated worse than this is named in a warning
+SMALL_ERROR = 1e-7       # every point better than this: the harmonics are more than needed
+
+
+def richer_basis(basis: FourierBasis) -> FourierBasis:
+    """The harmonics of ``basis`` continued to ``2 H + 1`` in the same pattern (odd only when
+    ``basis`` has odd harmonics only), mean kept when present, on ``N' >= 4 N`` samples."""
+    h = np.asarray(basis.harmonics)
+    top = 2 * int(h.max()) + 1
+    pos = h[h > 0]
+    step = 2 if np.all(pos % 2 == 1) and pos.size > 1 else 1
+    more = np.arange(int(h.max()) + step, top + 1, step)
+    hr = np.unique(np.concatenate([h, more]))
+    n = max(4 * basis.n_samples, 4 * top + 2)
+    return FourierBasis(hr, int(n))
+
+
+def embed(X: np.ndarray, basis: FourierBasis, richer: FourierBasis) -> np.ndarray:
+    """Coefficients ``X`` (n_coef, n) of ``basis`` as those of ``richer`` (new harmonics zero)."""
+    out = np.zeros((richer.n_coef, X.shape[1]))
+    for h in basis.harmonics:
+        if h == 0:
+            out[richer.row_of(0)] = X[basis.row_of(0)]
+        else:
+            out[richer.row_of(int(h), "c")] = X[basis.row_of(int(h), "c")]
+            out[richer.row_of(int(h), "s")] = X[basis.row_of(int(h), "s")]
+    return out
+
+
+def _h1(basis: FourierBasis, Y: np.ndarray) -> np.ndarray:
+    r = basis.row_of(1, "c")
+    return np.hypot(Y[r], Y[r + 1])
+
+
+def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
+    """Estimated relative error of every output's first harmonic at every point.
+
+    Parameters
+    ----------
+    problem, richer_problem
+        The FRF's problem and the same case on :func:`richer_basis`.
+    Xs : ndarray, shape (n_points, n_coef, n)
+    ws : ndarray, shape (n_points,)
+        rad/s.
+
+    Returns
+    -------
+    ndarray, shape (n_points, n_outputs)
+        NaN where the richer Jacobian is singular.
+    """
+    rp = richer_problem
+    out = np.full((len(ws), rp.linear.output_rows.shape[0]), np.nan)
+    for k, (X, w) in enumerate(zip(Xs, ws)):
+        Xr = embed(X, problem.basis, rp.basis)
+        R, J = rp.residual(Xr, float(w))[:2]
+        try:
+            d = np.linalg.solve(J, -R)
+        except np.linalg.LinAlgError:
+            continue
+        y0 = _h1(rp.basis, rp.recover_outputs(Xr, float(w)))
+        y1 = _h1(rp.basis, rp.recover_outputs(rp.expand(rp.unknowns(Xr) + d), float(w)))
+        out[k] = np.abs(y1 - y0) / np.maximum(y1, 1e-300)
+    return out

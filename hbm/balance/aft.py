@@ -1,0 +1,199 @@
+r"""Alternating frequency-time (AFT) evaluation of the nonlinear forces and their exact Jacobian.
+
+For every element with gather matrix ``G`` (n_local, n_nl) on the nonlinear DOFs:
+
+.. math::
+
+    U = X_{nl} G^T, \quad u = E U, \quad \dot u = w\, E' U, \quad
+    (f, \partial f) = \text{march}(u, \dot u), \quad
+    F_{nl} \mathrel{+}= (P f)\, G,
+
+and the Jacobian follows from the same march with forward-mode seeds
+``du_j/dU_{k,b} = E_{j,k} delta_{ab}`` (and ``d\dot u/dw = E' U``):
+
+.. math::
+
+    \frac{\partial F_{nl}}{\partial X_{nl}} = (I \otimes G^T)\, P\, \frac{\partial f}{\partial U}\,(I \otimes G),
+
+assembled by batched products with the small dense ``G`` (never as a Kronecker product).
+Only the DOFs touched by an element (the nonlinear DOFs) enter the AFT.  Law elements on the
+DFT-matrix transform take the compiled path of :mod:`hbm.balance.aft_kernel` (same numbers, three
+numba calls per law, linear periods without a march).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from hbm.balance.aft_kernel import aft_law
+from hbm.balance.fourier import FourierBasis
+
+
+def _seeds(basis: FourierBasis, n_local: int, dE: bool) -> np.ndarray:
+    """Seeds ``S[j, a, k*n_local + b] = E[j, k] delta_ab`` (last column, for w, left zero)."""
+    B = basis.dE if dE else basis.E
+    N, nc = B.shape
+    S = np.zeros((N, n_local, nc * n_local + 1))
+    for a in range(n_local):
+        S[:, a, a:nc * n_local:n_local] = B
+    return S
+
+
+class NonlinearForces:
+    """Harmonic nonlinear forces of a set of elements on a Fourier basis.
+
+    Parameters
+    ----------
+    basis : FourierBasis
+    elements : sequence of Element
+        Each with ``gather`` of shape (n_local, n_dof).
+    n_dof : int
+        Size of the model.
+    transform : object
+        A transform of :mod:`hbm.balance.transforms` built on ``basis``.
+
+    Attributes
+    ----------
+    dofs : ndarray of int, shape (n_nl,)
+        The DOFs touched by any element.
+    last_unclosed : int
+        Law parts whose hysteresis loop did not close within ``max_passes`` periods in the
+        last :meth:`evaluate` or :meth:`forces` call (their forces carry the closure error).
+    """
+
+    def __init__(self, basis, elements, n_dof, transform):
+        self.basis = basis
+        self.elements = tuple(elements)
+        self.transform = transform
+        self.last_unclosed = 0
+        used = np.zeros(n_dof, dtype=bool)
+        for e in self.elements:
+            if e.gather.shape[1] != n_dof:
+                raise ValueError(f"element {e.name}: gather has {e.gather.shape[1]} columns, model has {n_dof} DOFs")
+            used |= np.any(e.gather != 0.0, axis=0)
+        self.dofs = np.flatnonzero(used)
+        self._G = [np.ascontiguousarray(e.gather[:, self.dofs]) for e in self.elements]
+        self._seed_u = {}
+        self._seed_v = {}
+        # compiled path: (G rows of the law, LawSpec) per law part, or None for a generic element
+        compiled = getattr(transform, "name", "") == "dft"
+        self._parts = []
+        for e, G in zip(self.elements, self._G):
+            parts = e.law_parts() if compiled else None
+            self._parts.append(None if parts is None else
+                               [(np.ascontiguousarray(G[rows]), spec) for rows, spec in parts])
+        rows0 = np.flatnonzero(basis.h_of_row == 0)
+        self._row0 = int(rows0[0]) if rows0.size else -1
+        self._E = np.ascontiguousarray(basis.E)
+        self._dE = np.ascontiguousarray(basis.dE)
+        self._P = np.ascontiguousarray(basis.P)
+        for e, parts in zip(self.elements, self._parts):
+            if parts is not None:
+                continue
+            nl = e.n_local
+            if nl not in self._seed_u:
+                self._seed_u[nl] = _seeds(basis, nl, dE=False)
+                self._seed_v[nl] = _seeds(basis, nl, dE=True)
+
+    @property
+    def n_nl(self) -> int:
+        return self.dofs.size
+
+    def element_samples(self, Xnl: np.ndarray, w: float, index: int):
+        """Sampled inputs ``z`` (N, n_input) of element ``index`` for nonlinear-DOF coefficients."""
+        e = self.elements[index]
+        U = Xnl @ self._G[index].T
+        u = self.transform.synthesize(U)
+        if not e.velocity:
+            return u
+        return np.hstack([u, w * (self.basis.dE @ U)])
+
+    def evaluate(self, Xnl: np.ndarray, w: float, J_out: np.ndarray | None = None):
+        """Forces and exact derivatives.
+
+        Parameters
+        ----------
+        Xnl : ndarray, shape (n_coef, n_nl)
+            Harmonic coefficients of the nonlinear DOFs.
+        w : float
+            Fundamental angular frequency, rad/s.
+        J_out : ndarray, shape (n_coef * n_nl, n_coef * n_nl), optional
+            Array (or strided view, e.g. columns of a larger matrix) to write ``dFdX`` into
+            (overwritten; returned as ``dFdX``), so that a caller's Jacobian needs no second
+            ``n_u x n_u`` array.
+
+        Returns
+        -------
+        F : ndarray, shape (n_coef, n_nl)
+        dFdX : ndarray, shape (n_coef * n_nl, n_coef * n_nl)
+            Harmonic-major, consistent with ``Xnl.ravel()``.
+        dFdw : ndarray, shape (n_coef, n_nl)
+        """
+        Xnl = np.ascontiguousarray(Xnl, dtype=float)
+        nc = self.basis.n_coef
+        nn = self.n_nl
+        F = np.zeros((nc, nn))
+        if J_out is None:
+            # the layout of a Jacobian inside a bordered matrix (the continuation's), so that
+            # the kernels below are compiled once, not once per layout
+            J_out = np.empty((nc * nn, nc * nn + 1))[:, :-1]
+        s0, s1 = J_out.strides                       # a view on J_out's memory, whatever its strides
+        J4 = np.lib.stride_tricks.as_strided(J_out, (nc, nn, nc, nn), (nn * s0, s0, nn * s1, s1))
+        J4[...] = 0.0
+        dFdw = np.zeros((nc, nn))
+        N = self.basis.n_samples
+        unclosed = 0
+        for e, G, parts in zip(self.elements, self._G, self._parts):
+            if parts is not None:
+                for Gp, sp in parts:
+                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw) < 0
+                continue
+            nl = e.n_local
+            U = Xnl @ G.T
+            u = self.transform.synthesize(U)
+            if e.velocity:
+                du_dth = self.basis.dE @ U
+                z = np.hstack([u, w * du_dth])
+                sv = w * self._seed_v[nl]
+                sv[:, :, -1] = du_dth
+                dz = np.concatenate([self._seed_u[nl], sv], axis=1)
+            else:
+                z = u
+                dz = self._seed_u[nl]
+            f, df = e.march(z, dz)
+            Pcols = df.shape[2]
+            Fe = self.transform.analyse(f)
+            dFe = self.transform.analyse(df.reshape(N, nl * Pcols)).reshape(nc, nl, Pcols)
+            F += Fe @ G
+            dFdw += dFe[:, :, -1] @ G
+            # (G^T dU G) on the DOF axes: two plain matrix products, no transposes
+            dU = dFe[:, :, :-1]                                   # (nc, nl, nc * nl)
+            T = np.matmul(G.T, dU)                                # (nc, nn, nc * nl)
+            J4 += (T.reshape(nc * nn * nc, nl) @ G).reshape(nc, nn, nc, nn)
+        self.last_unclosed = int(unclosed)
+        return F, J_out, dFdw
+
+    def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:
+        """Forces only, (n_coef, n_nl): the march runs with a single zero seed."""
+        Xnl = np.ascontiguousarray(Xnl, dtype=float)
+        F = np.zeros((self.basis.n_coef, self.n_nl))
+        unclosed = 0
+        for i, parts in enumerate(self._parts):
+            if parts is not None:
+                for Gp, sp in parts:
+                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F) < 0
+                continue
+            z = self.element_samples(Xnl, w, i)
+            f, _ = self.elements[i].march(z, np.zeros(z.shape + (1,)))
+            F += self.transform.analyse(f) @ self._G[i]
+        self.last_unclosed = int(unclosed)
+        return F
+
+    def element_forces(self, Xnl: np.ndarray, w: float):
+        """Per element: sampled inputs ``z`` (N, n_input) and forces ``f`` (N, n_local)."""
+        out = []
+        for i, e in enumerate(self.elements):
+            z = self.element_samples(Xnl, w, i)
+            dz = np.zeros(z.shape + (1,))
+            f, _ = e.march(z, dz)
+            out.append((z, f))
+        return out

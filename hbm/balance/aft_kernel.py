@@ -1,0 +1,278 @@
+r"""AFT of one law on DFT matrices: inputs, march, analysis + gather, compiled per closure.
+
+For a law acting on local coordinates ``u = G q`` (``G`` (n_l, n_nl) on the nonlinear DOFs)
+with coefficients ``U = X G^T`` (n_coef, n_l):
+
+.. math::
+
+    u = E U,\ \dot u = w\, E' U, \qquad (f, \partial f) = \text{march}(u, \dot u), \qquad
+    F \mathrel{+}= (P f)\, G, \qquad
+    \frac{\partial F_{k i}}{\partial X_{m j}} \mathrel{+}=
+        \sum_{a b} G_{a i}\, \frac{\partial (P f)_{k a}}{\partial U_{m b}}\, G_{b j},
+
+with the march seeded by ``du_{j a}/dU_{m b} = E_{j m} \delta_{a b}`` (and, for velocity
+laws, ``d\dot u/dU = w E'``, ``d\dot u/dw = E' U``).  When the law is linear over the whole
+period (:func:`elements.law_march.linear_shortcut`: ``f = f_0 + K z``), the coefficients
+follow without marching or transforming, ``P f = K U + f_0 e_0`` (``e_0`` the mean row) and
+``\partial (P f)/\partial U = K \otimes I``, because ``P E = I`` on an alias-free grid.
+
+This is the path :class:`hbm.balance.aft.NonlinearForces` takes for law elements when the
+transform is the DFT matrix (few harmonics); it returns the same numbers as the generic path
+(element ``march`` between transform calls), to round-off.  One compiled function per law
+and closure (:func:`make_aft_law`), with the law's step inlined into the march: a single
+function dispatching to both closures made numba link and re-optimise both (with their LAPACK
+calls) into it, which multiplied the first run's compile time (measured: 16 s -> 59 s CPU for
+the default rig), and a march generic in the law compiles every law and calls its step per
+sample.  The steps avoid BLAS/LAPACK bindings where loops do.
+"""
+from __future__ import annotations
+
+import functools
+
+import numba as nb
+import numpy as np
+
+from elements.closure import newton_body
+from elements.kernels import march_body
+from elements.law_march import CLOSE_NEWTON, linear_shortcut, start_sample
+
+
+@nb.njit(cache=True)
+def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
+    """Coordinates, march inputs and seeds of one law, or its linear shortcut.
+
+    Parameters
+    ----------
+    kind, p, start_rule, n_start, velocity
+        The law (:class:`elements.base.LawSpec`).
+    seeds : bool
+        Seed the march with ``dz/dU`` (and ``dz/dw``); False: no seeds (forces only).
+    G : ndarray, shape (n_l, n_nl)
+    X : ndarray, shape (n_coef, n_nl)
+        Coefficients of the nonlinear DOFs.
+    w : float
+    E, dE : ndarray, shape (N, n_coef)
+        Synthesis matrix and its derivative in the phase.
+
+    Returns
+    -------
+    U : ndarray, shape (n_coef, n_l)
+    z : ndarray, shape (N, n_z)
+    dz : ndarray, shape (N, n_z, P)
+        ``P = n_coef n_l + 1`` with seeds, else 0.
+    start : int
+        Start sample of the march.
+    linear : bool
+        The law is linear over the period: ``f = f0 + K z`` (then ``dz`` is not filled).
+    K : ndarray, shape (n_l, n_z)
+    f0 : ndarray, shape (n_l,)
+    """
+    nc, nn = X.shape
+    nl = G.shape[0]
+    N = E.shape[0]
+    U = np.zeros((nc, nl))
+    for a in range(nl):
+        for i in range(nn):
+            g = G[a, i]
+            if g != 0.0:
+                for k in range(nc):
+                    U[k, a] += X[k, i] * g
+    nz = 2 * nl if velocity else nl
+    z = np.zeros((N, nz))
+    dth = np.zeros((N, nl))
+    for j in range(N):          # synthesis by loops: small, and no BLAS binding to compile
+        for k in range(nc):
+            e = E[j, k]
+            de = dE[j, k]
+            for a in range(nl):
+                z[j, a] += e * U[k, a]
+                if velocity:
+                    dth[j, a] += de * U[k, a]
+    if velocity:
+        for j in range(N):
+            for a in range(nl):
+                z[j, nl + a] = w * dth[j, a]
+    K = np.zeros((nl, nz))
+    f0 = np.zeros(nl)
+    Pc = nc * nl + 1 if seeds else 0
+    linear = (not velocity) and linear_shortcut(kind, p, z, K, f0)
+    if linear:
+        return U, z, np.zeros((0, nz, Pc)), 0, True, K, f0
+    dz = np.empty((N, nz, Pc))     # every entry written once below (no zero fill first)
+    if seeds:
+        for j in range(N):
+            for a in range(nl):
+                for m in range(nc):
+                    e = E[j, m]
+                    for b in range(nl):
+                        dz[j, a, m * nl + b] = e if a == b else 0.0
+                dz[j, a, Pc - 1] = 0.0
+            if velocity:
+                for a in range(nl):
+                    for m in range(nc):
+                        de = w * dE[j, m]
+                        for b in range(nl):
+                            dz[j, nl + a, m * nl + b] = de if a == b else 0.0
+                    dz[j, nl + a, Pc - 1] = dth[j, a]
+    return U, z, dz, start_sample(start_rule, n_start, z), False, K, f0
+
+
+@nb.njit(cache=True)
+def _gather(G, Fe, dFe, F, J4, dFdw, seeds):
+    """``F += Fe G``; with seeds also ``dFdw += dFe[..., -1] G`` and
+    ``J4[k, :, m, :] += G^T dFe[k, :, m-block] G`` (loops skip the zeros of ``G``)."""
+    nc = Fe.shape[0]
+    nl, nn = G.shape
+    for a in range(nl):
+        for i in range(nn):
+            g = G[a, i]
+            if g == 0.0:
+                continue
+            for k in range(nc):
+                F[k, i] += Fe[k, a] * g
+                if seeds:
+                    dFdw[k, i] += dFe[k, a, dFe.shape[2] - 1] * g
+    if not seeds:
+        return
+    for k in range(nc):
+        for a in range(nl):
+            for m in range(nc):
+                for b in range(nl):
+                    d = dFe[k, a, m * nl + b]
+                    if d == 0.0:
+                        continue
+                    for i in range(nn):
+                        ga = G[a, i]
+                        if ga == 0.0:
+                            continue
+                        for j in range(nn):
+                            gb = G[b, j]
+                            if gb != 0.0:
+                                J4[k, i, m, j] += ga * d * gb
+
+
+@nb.njit(cache=True)
+def aft_analyse(P, f, df, G, F, J4, dFdw, seeds):
+    """Analysis ``P f``, ``P df`` of a marched period and the gather onto the nonlinear DOFs.
+
+    Parameters
+    ----------
+    P : ndarray, shape (n_coef, N)
+    f : ndarray, shape (N, n_l)
+    df : ndarray, shape (N, n_l, P_s)
+    G : ndarray, shape (n_l, n_nl)
+    F, dFdw : ndarray, shape (n_coef, n_nl)
+        Accumulated in place (``dFdw`` only with seeds).
+    J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl)
+        Accumulated in place (only with seeds).
+    seeds : bool
+    """
+    nc, N = P.shape
+    nl = f.shape[1]
+    Fe = P @ f
+    if seeds:
+        Ps = df.shape[2]
+        dFe = (P @ np.ascontiguousarray(df).reshape(N, nl * Ps)).reshape(nc, nl, Ps)
+    else:
+        dFe = np.zeros((nc, nl, 1))
+    _gather(G, Fe, dFe, F, J4, dFdw, seeds)
+
+
+@nb.njit(cache=True)
+def aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds):
+    """Gather of a linear period: ``P f = K U + f0 e_0``, ``d(P f)/dU = K (x) I`` (module doc).
+
+    ``row0`` is the row of the mean (harmonic 0), -1 if absent; other arguments as
+    :func:`aft_analyse`.
+    """
+    nc, nl = U.shape
+    Pc = nc * nl + 1 if seeds else 1
+    Fe = np.zeros((nc, nl))
+    dFe = np.zeros((nc, nl, Pc))
+    for a in range(nl):
+        for b in range(nl):
+            kab = K[a, b]
+            if kab != 0.0:
+                for k in range(nc):
+                    Fe[k, a] += kab * U[k, b]
+                    if seeds:
+                        dFe[k, a, k * nl + b] = kab
+        if row0 >= 0:
+            Fe[row0, a] += f0[a]
+    _gather(G, Fe, dFe, F, J4, dFdw, seeds)
+
+
+def make_aft_law(kind, closure):
+    """The three steps (inputs, march, analysis + gather) compiled for one law and closure:
+    ``run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds, G, X, w, E, dE, P,
+    row0, F, J4, dFdw) -> passes`` (arguments as :func:`aft_law`).
+
+    ``kind`` and ``closure`` are constants of the compiled function (ints in its closure cells,
+    which numba's cache keys by value): numba prunes the other laws and the other closure
+    before typing, so only this law's march is compiled, its step inlined into the sample
+    loop (:func:`elements.law_march.make_law_march`).  Use :func:`aft_of`.
+    """
+    kind = int(kind)
+    newton = int(closure) == CLOSE_NEWTON
+
+    @nb.njit(cache=True)
+    def run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
+            G, X, w, E, dE, P, row0, F, J4, dFdw):
+        U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
+                                                    G, X, w, E, dE)
+        if linear:
+            aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
+            return 0
+        if newton:
+            f, df, passes = newton_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
+        else:
+            f, df, passes = march_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
+        aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
+        return passes
+
+    return run
+
+
+# not touched without seeds; strided like a Jacobian inside a bordered matrix (as the seeded
+# calls pass it), so that each law's kernel is compiled for one layout only
+_NO_J4 = np.zeros((1, 1, 2, 2))[:, :, :, :1]
+
+
+@functools.cache
+def aft_of(kind, closure):
+    """:func:`make_aft_law` of ``(kind, closure)``, built once per process (the cache holds
+    compiled code only)."""
+    return make_aft_law(kind, closure)
+
+
+def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
+    """Add one law's harmonic forces (and, given ``J4`` and ``dFdw``, exact derivatives).
+
+    Parameters
+    ----------
+    spec : elements.base.LawSpec
+    G : ndarray, shape (n_l, n_nl)
+    X : ndarray, shape (n_coef, n_nl)
+        Coefficients of the nonlinear DOFs (C-contiguous).
+    w : float
+    E, dE : ndarray, shape (N, n_coef)
+    P : ndarray, shape (n_coef, N)
+    row0 : int
+        Row of the mean (harmonic 0), -1 if absent.
+    F : ndarray, shape (n_coef, n_nl)
+    J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl), optional
+    dFdw : ndarray, shape (n_coef, n_nl), optional
+        All accumulated in place.  Without them the march carries no seeds at all.
+
+    Returns
+    -------
+    passes : int
+        Periods marched (0: linear shortcut; negative: the loop did not close).
+    """
+    if J4 is None:
+        return aft_of(spec.kind, spec.closure)(
+            spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
+            spec.tol, False, G, X, w, E, dE, P, row0, F, _NO_J4, F)
+    return aft_of(spec.kind, spec.closure)(
+        spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
+        spec.tol, True, G, X, w, E, dE, P, row0, F, J4, dFdw)

@@ -1,0 +1,1 @@
+"""The linear structure: matrices, modal reduction with residual flexibility, model files."""

@@ -1,0 +1,1 @@
+"""The time-domain reference: implicit integration, shooting and Floquet multipliers."""

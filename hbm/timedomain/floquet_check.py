@@ -1,0 +1,175 @@
+r"""Floquet stability of a harmonic-balance point, from the time integrator's period map.
+
+A balance point (coefficients ``X`` (n_coef, n) at ``w``) gives the start of a period,
+
+.. math::
+
+    q_0 = E_0 X, \qquad v_0 = w\, E'_0 X, \qquad a_0 = w^2 E_0 D^2 X ,
+
+(``E_0`` the synthesis row at ``theta = 0``, ``E'_0`` its derivative, ``D`` the derivative
+operator) and the law states that the laws reach along the balance's motion (stepped through
+two periods of ``z(t) = G E X`` sampled on the integrator's grid, so a friction state carries
+its hysteresis).  Shooting (:func:`hbm.timedomain.shooting.shoot`) then finds the periodic solution of the
+discrete time map next to it (Newton converges to unstable solutions as well), and its
+monodromy matrix gives the Floquet multipliers: the time-domain check of Hill's verdict.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from elements.kernels import law_init, law_step
+
+from hbm.balance.fourier import FourierBasis, basis_matrix
+from hbm.timedomain.shooting import floquet_verdict, set_state, shoot
+from hbm.timedomain.time_parts import pack_elements
+from hbm.timedomain.time_results import TimeSimOptions
+
+
+@dataclass(frozen=True)
+class FloquetCheck:
+    """Floquet verdict of one balance point.
+
+    Attributes
+    ----------
+    stable : bool
+        Every multiplier within ``1 + FLOQUET_MARGIN`` (meaningful only if ``converged``).
+    largest : float
+        Largest ``|mu|``.
+    converged : bool
+        Shooting found the periodic time solution.
+    distance : float
+        ``max|q_time - q_balance|`` over the period, relative to ``max|q_balance|``: how far
+        the time solution is from the balance point (same branch if small).
+    message : str
+    """
+
+    stable: bool
+    largest: float
+    converged: bool
+    distance: float
+    message: str
+
+
+def _start_states(packed, G_all_q: np.ndarray):
+    """Law states at phase 0 after stepping every part through two periods of its inputs.
+
+    ``G_all_q`` (N, n_rows) are the parts' inputs ``G_p q(t_j)`` on the step grid (no
+    velocity laws: those read ``G_p v`` as well, see :func:`start_state`).
+    """
+    kinds, p_all, p_off, s_off, g_all, g_off, vel, d_off = packed.laws
+    S = np.zeros(int(s_off[-1]))
+    for p in range(kinds.size):
+        rows = slice(g_off[p], g_off[p + 1])
+        z = np.ascontiguousarray(G_all_q[:, rows])
+        nin = z.shape[1]
+        ns = s_off[p + 1] - s_off[p]
+        params = p_all[p_off[p]:p_off[p + 1]]
+        s = np.zeros(ns)
+        s_new = np.zeros(ns)
+        law_init(kinds[p], params, np.ascontiguousarray(z[0]), s, np.zeros((ns, nin)))
+        A, B = np.zeros((ns, ns)), np.zeros((ns, nin))
+        for j in (list(range(1, z.shape[0])) + [0]) * 2:
+            law_step(kinds[p], params, s, np.ascontiguousarray(z[j]), s_new, A, B)
+            s[:] = s_new
+        S[s_off[p]:s_off[p + 1]] = s
+    return S
+
+
+def start_state(packed, basis: FourierBasis, X: np.ndarray, w: float, steps: int) -> np.ndarray:
+    """``y = [q, v, a, S]`` at phase 0 of the balance point ``X`` (n_coef, n_dof) of a model
+    whose law parts are ``packed`` (:func:`hbm.timedomain.time_parts.pack_elements`)."""
+    if np.any(packed.laws[6]):
+        raise ValueError("the Floquet check of a balance point does not handle velocity-dependent laws")
+    theta = 2.0 * np.pi * np.arange(steps) / steps
+    q_t = basis_matrix(basis.h_of_row, theta) @ X
+    S = _start_states(packed, q_t @ packed.laws[4].T)
+    q0 = basis.E[0] @ X
+    v0 = w * (basis.dE[0] @ X)
+    a0 = w * w * (basis.E[0] @ (basis.D @ (basis.D @ X)))
+    return np.concatenate([q0, v0, a0, S])
+
+
+def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps: int = 1024,
+                tol: float = 1e-7, max_iter: int = 12) -> FloquetCheck:
+    """Floquet verdict of the balance point ``X`` (n_coef, n_dof: all DOFs) at ``freq_hz``.
+
+    Raises
+    ------
+    ValueError
+        Support excitation or velocity-dependent laws (not handled here).
+    """
+    from hbm.timedomain.time_state import TimeState, kernel_model
+    from hbm.timedomain.timesim import _one_period
+    if case.excitation.base is not None:
+        raise ValueError("the Floquet check of a balance point does not handle support excitation")
+    w = 2.0 * np.pi * freq_hz
+    packed = pack_elements(case.elements, case.n_dof)
+    state = TimeState(case, packed, w)
+    set_state(state, start_state(packed, basis, X, w, steps), packed.laws)
+    opts = TimeSimOptions(steps=steps)
+    periods = []
+
+    def one_period(st, Y):
+        q = _one_period(case, freq_hz, opts, steps, packed)(st, Y)
+        periods.append(q)
+        return q
+
+    shot = shoot(one_period, state, kernel_model(case), packed.laws, w, tol, max_iter)
+    stable, big = floquet_verdict(shot.multipliers)
+    theta = 2.0 * np.pi * np.arange(steps + 1) / steps
+    q_hb = basis_matrix(basis.h_of_row, theta) @ X
+    dist = float(np.abs(periods[-1] - q_hb).max() / max(np.abs(q_hb).max(), 1e-300))
+    return FloquetCheck(stable, big, shot.converged, dist, shot.message)
+
+
+MAX_CONFIRM = 40            # Hill-unstable points checked per FRF at most
+MAX_STATE = 400             # 3 n + n_S above which the check is not run (cost ~ m n^2 per step)
+CONFIRM_STEPS = 1024
+
+
+def _non_smooth(packed) -> bool:
+    from elements.laws.registry import COULOMB_REGULARISED, CUBIC
+    return bool(np.any(~np.isin(packed.laws[0], (CUBIC, COULOMB_REGULARISED))))
+
+
+def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndarray,
+                     stable: np.ndarray, settings: dict) -> np.ndarray:
+    """Hill's unstable verdicts checked by Floquet multipliers where Hill is not exact.
+
+    Hill's method linearises the balance; for stick-slip, contact and stuck-friction laws the
+    linearised harmonic operator can flag a point whose time solution is stable (seen on
+    the blade couple at 115.96 Hz: an isolated flag that comes and goes with H, while the
+    period map's largest multiplier is 0.987).  Each point Hill calls unstable (at most
+    ``MAX_CONFIRM``) is checked with :func:`check_point` when the model has a non-smooth law,
+    is small (``3 n + n_S <= MAX_STATE``), has no support excitation and no velocity law; a
+    converged Floquet verdict replaces Hill's.  ``settings["floquet_checked"]`` counts the
+    checks, ``settings["floquet_overrides_hz"]`` lists the points turned stable.
+
+    Parameters
+    ----------
+    Xs : ndarray, shape (n_points, n_coef, n_dof)
+        Every DOF's coefficients (full solver).
+    stable : ndarray of bool, shape (n_points,)
+
+    Returns
+    -------
+    ndarray of bool, shape (n_points,)
+    """
+    packed = pack_elements(case.elements, case.n_dof)
+    bad = np.flatnonzero(~stable)
+    if (not bad.size or not _non_smooth(packed) or np.any(packed.laws[6]) or case.excitation.base is not None
+            or 3 * case.n_dof + packed.n_states > MAX_STATE or Xs.shape[-1] != case.n_dof):
+        return stable
+    out = stable.copy()
+    turned = []
+    for i in bad[:MAX_CONFIRM]:
+        c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=CONFIRM_STEPS)
+        if c.converged and c.stable:
+            out[i] = True
+            turned.append(round(float(freq_hz[i]), 6))
+    settings["floquet_checked"] = int(min(bad.size, MAX_CONFIRM))
+    if turned:
+        settings["floquet_overrides_hz"] = turned
+    return out
