@@ -14,7 +14,6 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-import time
 import tomllib
 from pathlib import Path
 
@@ -24,12 +23,12 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import hbm                                      # noqa: E402
 from hbm.interface.case import case_from_dict, load_case  # noqa: E402
+from time_vs_error import cpu, target_case       # noqa: E402
 
 TARGETS = {"three_dof_two_jenkins": 0.5, "upd_rig": 1.0}
 
 
 def cases():
-    from time_vs_error import target_case
     upd_like = tomllib.loads((ROOT / "benchmarks" / "upd_like.toml").read_text())
     return {
         "three_dof_two_jenkins": target_case,
@@ -37,15 +36,6 @@ def cases():
         "upd_rig": lambda: load_case(ROOT / "rigs" / "upd_rig.toml"),
         "blade_couple": lambda: load_case(ROOT / "rigs" / "blade_couple.toml"),
     }
-
-
-def cpu(fun, repeat):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        t0 = time.process_time()
-        out = fun()
-        best = min(best, time.process_time() - t0)
-    return best, out
 
 
 def main(argv=None):

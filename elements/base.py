@@ -179,6 +179,23 @@ class Element:
         raise NotImplementedError(f"{type(self).__name__} has no per-period outputs")
 
 
+def rest_tangents(elements, n: int):
+    """Stiffness and viscous tangents at rest of ``elements`` on ``n`` coordinates, summed as
+    ``sum_e G_e^T K_e G_e`` (``linear_stiffness``; ``linear_damping`` where an element has one).
+
+    Returns
+    -------
+    K, C : ndarray, shape (n, n)
+    """
+    K, C = np.zeros((n, n)), np.zeros((n, n))
+    for e in elements:
+        K += e.gather.T @ e.linear_stiffness() @ e.gather
+        cd = getattr(e, "linear_damping", None)
+        if cd is not None:
+            C += e.gather.T @ cd() @ e.gather
+    return K, C
+
+
 def slider_summary(f, u, kt) -> dict:
     r"""Per-period outputs of a spring ``kt`` in series with a slider on one coordinate.
 

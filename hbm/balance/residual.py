@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from elements.base import rest_tangents
+
 from hbm.balance.aft import NonlinearForces
 from hbm.balance.energy import EnergyBalance, work
 from hbm.analyses.modal_hill import ModalData
@@ -155,19 +157,11 @@ class HarmonicBalance:
 
     def stuck_stiffness(self) -> np.ndarray:
         """Tangent stiffness of the elements at rest on the coordinates, (n, n)."""
-        K = np.zeros((self.n_dof, self.n_dof))
-        for e in self.nl.elements:
-            K += e.gather.T @ e.linear_stiffness() @ e.gather
-        return K
+        return rest_tangents(self.nl.elements, self.n_dof)[0]
 
     def stuck_damping(self) -> np.ndarray:
         """Viscous tangent at rest of velocity-dependent elements (``linear_damping``), (n, n)."""
-        C = np.zeros((self.n_dof, self.n_dof))
-        for e in self.nl.elements:
-            cd = getattr(e, "linear_damping", None)
-            if cd is not None:
-                C += e.gather.T @ cd() @ e.gather
-        return C
+        return rest_tangents(self.nl.elements, self.n_dof)[1]
 
     # ------------------------------------------------------------------ what the analyses ask
     def modal_rows(self) -> np.ndarray:

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from elements.base import rest_tangents
+
 from hbm.interface.case import Case
 from hbm.timedomain.shooting import Balance
 from hbm.timedomain.time_kernels import element_forces, init_states
@@ -48,8 +50,7 @@ class TimeState:
         self.v = np.zeros(n)
         if fx.size:
             self.q[fx] = ybase[fx]
-            Ks = K + sum((e.gather.T @ e.linear_stiffness() @ e.gather for e in case.elements),
-                         np.zeros_like(K))
+            Ks = K + rest_tangents(case.elements, n)[0]
             self.q[fr] = -np.linalg.lstsq(Ks[np.ix_(fr, fr)], Ks[np.ix_(fr, fx)] @ ybase[fx], rcond=None)[0]
         self.S = np.zeros(packed.n_states)
         self.D = np.zeros(packed.n_tangents)
