@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative
+from .base import Element, coordinate_rows, require_keys, finite, positive, non_negative
 from .law_march import START_PRINCIPAL, CLOSE_NEWTON
 from .laws.registry import FRICTION3D
 
@@ -13,7 +13,8 @@ class Friction3D(Element):
     """Macroslip point contact on local coordinates (t1, t2, n), or (t1, n) without ``t2``.
 
     Case keys: ``type``, ``dofs = {t1 = ..., t2 = ..., n = ...}`` (``t2`` optional), ``kt``,
-    ``kn`` (> 0), ``mu`` (>= 0), ``normal_preload`` (``N0 >= 0``), optional ``name``.
+    ``kn`` (> 0), ``mu`` (>= 0), ``normal_preload`` (``N0 >= 0``), optional ``normal_gap``
+    (``g``, default 0) and ``name``.
 
     Each local coordinate is a linear combination of model DOFs, one row of the gather
     matrix (:func:`elements.base.coordinate_row`):
@@ -32,9 +33,13 @@ class Friction3D(Element):
       ``[dof, number]``, a DOF twice, all coefficients zero, pairs mixed with bare DOFs)
       are rejected with the coordinate named (``dofs.t1``).
 
-    The normal load is ``N = max(N0 + kn u_n, 0)`` (``u_n > 0`` closes); the element force
-    along ``n`` is ``N - N0`` (zero at rest, ``-N0`` while open).  The tangential force obeys
-    Coulomb's law with a circular limit ``mu N`` and a stick stiffness ``kt``.
+    The normal load is ``N = max(N0 + kn (u_n - g), 0)`` (``u_n > 0`` closes); the element
+    force along ``n`` is ``N - N_rest`` with ``N_rest = max(N0 - kn g, 0)`` the load at rest
+    (zero at rest, ``-N_rest`` while open).  ``g > 0`` is an initial gap (open at rest, closes
+    when ``u_n`` exceeds ``g - N0 / kn``), ``g < 0`` an interference (a static load
+    ``-kn g`` added to ``N0``), as Petrov & Ewins (2003) model both.  The law sees only
+    ``N0 - kn g`` (``laws/friction3d.py``).  The tangential force obeys Coulomb's law with a
+    circular limit ``mu N`` and a stick stiffness ``kt``.
 
     State layout (``nt`` = 1 or 2 tangential directions): ``[f_t (nt), f_n, u_t,prev (nt)]``.
 
@@ -56,7 +61,7 @@ class Friction3D(Element):
     kind = FRICTION3D
     velocity = False
     needs_mean = True       # normal-load variation gives mean forces
-    keys = ("type", "dofs", "kt", "kn", "mu", "normal_preload", "name")
+    keys = ("type", "dofs", "kt", "kn", "mu", "normal_preload", "normal_gap", "name")
     dof_keys = ("t1", "t2", "n")
     quantities = ("normal_load_min", "normal_load_max", "open_fraction", "slip_fraction",
                   "dissipation")
@@ -67,14 +72,16 @@ class Friction3D(Element):
     default_harmonics = 3           # benchmarks/default_harmonics.py
     default_samples_factor = 2
 
-    def __init__(self, gather, kt, kn, mu, normal_preload, name="friction3d"):
+    def __init__(self, gather, kt, kn, mu, normal_preload, name="friction3d", normal_gap=0.0):
         G = np.array(gather, dtype=float, ndmin=2)
         if G.shape[0] not in (2, 3):
             raise ValueError(f"{name}: friction3d needs 2 (t1, n) or 3 (t1, t2, n) coordinates, "
                              f"got {G.shape[0]}")
         nt = G.shape[0] - 1
-        params = np.array([positive("kt", kt), positive("kn", kn), non_negative("mu", mu),
-                           non_negative("normal_preload", normal_preload), float(nt)])
+        self.gap = finite("normal_gap", normal_gap)
+        kn = positive("kn", kn)
+        n_gap = non_negative("normal_preload", normal_preload) - kn * self.gap
+        params = np.array([positive("kt", kt), kn, non_negative("mu", mu), n_gap, float(nt)])
         super().__init__(G, params, name)
         self.n_state = 2 * nt + 1
         self.coord_names = ("t1", "t2", "n") if nt == 2 else ("t1", "n")
@@ -91,7 +98,7 @@ class Friction3D(Element):
         G = coordinate_rows([dofs[k] for k in names], n_dof, dof_index,
                             [f"{where}: dofs.{k}" for k in names])
         return cls(G, spec["kt"], spec["kn"], spec["mu"], spec["normal_preload"],
-                   spec.get("name", "friction3d"))
+                   spec.get("name", "friction3d"), spec.get("normal_gap", 0.0))
 
     @property
     def n_tangential(self) -> int:
@@ -111,20 +118,23 @@ class Friction3D(Element):
 
     @property
     def normal_preload(self):
-        return float(self.params[3])
+        """Normal load at rest, ``N_rest = max(N0 - kn g, 0)``: ``N = f_n + N_rest``."""
+        return max(float(self.params[3]), 0.0)
 
     @property
     def n_start(self) -> int:
         return self.n_tangential
 
     def linear_stiffness(self):
-        """Tangent at rest: ``kn`` along n (closing side), ``kt`` along t1, t2 if ``mu N0 > 0``."""
+        """Tangent at rest: ``kn`` along n unless a gap holds the contact open (closing side
+        when it just touches), ``kt`` along t1, t2 if ``mu N_rest > 0``."""
         nt = self.n_tangential
         kt = self.kt if self.mu * self.normal_preload > 0.0 else 0.0
-        return np.diag([kt] * nt + [self.kn])
+        kn = self.kn if self.params[3] >= 0.0 else 0.0
+        return np.diag([kt] * nt + [kn])
 
     def static_state(self) -> dict:
-        return {"normal_preload": self.normal_preload}
+        return {"normal_preload": self.normal_preload, "normal_gap": self.gap}
 
     def summary(self, f, z) -> dict:
         """Per-period quantities from the marched samples.
@@ -149,7 +159,7 @@ class Friction3D(Element):
         z = np.asarray(z, dtype=float)
         nt = self.n_tangential
         Nload = f[:, nt] + self.normal_preload
-        closed = self.normal_preload + self.kn * z[:, nt] > 0.0
+        closed = self.params[3] + self.kn * z[:, nt] > 0.0
         ft = f[:, :nt]
         ut = z[:, :nt]
         trial = np.roll(ft, 1, axis=0) + self.kt * (ut - np.roll(ut, 1, axis=0))

@@ -11,8 +11,9 @@ Normal law (no memory), ``u_n > 0`` closes the contact:
 
 so the element force is zero at rest and ``-N0`` while the contact is open (the static load
 that creates ``N0`` is balanced elsewhere: forces are dynamic forces about equilibrium).
-``N0 < 0`` is a gap of ``-N0 / kn`` at rest (a brush bristle clear of the indenter): the
-contact is open at rest and ``f_n = N``, again zero at rest.
+``N0 < 0`` is a gap of ``-N0 / kn`` at rest (a brush bristle clear of the indenter, or a
+friction3d element with ``normal_gap > 0``: ``N0 = N_pre - kn g``): the contact is open at
+rest and ``f_n = N``, again zero at rest.
 
 Tangential law: an incremental return mapping with a circular slip limit ``mu N``:
 
@@ -144,8 +145,8 @@ def friction3d_init(p, z0, s0, C0):
 @nb.njit(cache=True, inline="always")
 def friction3d_linear(p, z, K, f0):
     """True when the contact is linear at every sample: closed and stuck from rest
-    (``K = diag(kt, ..., kt, kn)``, ``f0 = 0``), or open throughout (``K = 0``,
-    ``f0 = [0, ..., -N0]``)."""
+    (``K = diag(kt, ..., kt, kn)``, ``f0 = [0, ..., min(N0, 0)]``), or open throughout
+    (``K = 0``, ``f0 = [0, ..., -max(N0, 0)]``): the normal law's ``N - max(N0, 0)``."""
     kt = p[0]
     kn = p[1]
     mu = p[2]
@@ -168,11 +169,12 @@ def friction3d_linear(p, z, K, f0):
     K[:, :] = 0.0
     f0[:] = 0.0
     if n_open == N:
-        f0[nt] = -N0
+        f0[nt] = -N0 if N0 > 0.0 else 0.0
         return True
     if n_open > 0:
         return False
     for a in range(nt):
         K[a, a] = kt
     K[nt, nt] = kn
+    f0[nt] = N0 if N0 < 0.0 else 0.0
     return True

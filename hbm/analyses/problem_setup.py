@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from continuation import Arclength, ArclengthOptions
 from hbm.analyses.budget import check_memory
 from hbm.interface.case import Case, CaseError
 from hbm.balance.condensed import condensed_balance
@@ -168,8 +169,10 @@ def _first_point(problem, case, w0, scale, r_scale):
     """Converged first point ``X`` (n_coef, n) at ``w0``, or raise RuntimeError with the reason.
 
     Newton from the linear response with the elements stuck, then without them; failing
-    both, the Newton homotopy ``R(x) - (1 - lam) R(0)`` from ``lam = 0`` (solved by ``x = 0``)
-    to ``lam = 1``.
+    both, the Newton homotopy ``H(x, lam) = R(x) - (1 - lam) R(0)`` from ``lam = 0`` (solved
+    by ``x = 0``) to ``lam = 1``: first in fixed steps of ``lam``, then, if a step fails (the
+    homotopy path folds back in ``lam``: a contact that closes or a jump up the resonance),
+    traced by pseudo-arclength continuation through its folds (:func:`_homotopy_path`).
     """
     fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
     guesses = [problem.linear_solution(w0, problem.stuck_stiffness()), problem.linear_solution(w0)]
@@ -189,11 +192,50 @@ def _first_point(problem, case, w0, scale, r_scale):
         res = newton(fun_l, x, scale=scale, r_scale=r_scale, max_iter=60)
         its += res.iterations
         if not res.converged:
-            raise RuntimeError(f"first point at {w0 / (2 * np.pi):.6g} Hz did not converge "
-                               f"(linear starts: {last.message}; ramp stopped at {lam:.0%} of the excitation: "
-                               f"{res.message})")
+            break
         x = res.x
-    return problem.expand(x), its
+    else:
+        return problem.expand(x), its
+    ramp = f"ramp stopped at {lam:.0%} of the excitation: {res.message}"
+    x, its_h, why = _homotopy_path(fun, R0, scale, r_scale)
+    if x is None:
+        raise RuntimeError(f"first point at {w0 / (2 * np.pi):.6g} Hz did not converge "
+                           f"(linear starts: {last.message}; {ramp}; {why})")
+    return problem.expand(x), its + its_h
+
+
+def _homotopy_path(fun, R0, scale, r_scale, max_steps=400):
+    """Solve ``R(x) = 0`` by tracing ``H(x, lam) = R(x) - (1 - lam) R0`` from ``(0, 0)`` to
+    ``lam = 1`` with :class:`continuation.Arclength` (``dH/dlam = R0``), then Newton on ``R``
+    from the point on ``lam = 1``.
+
+    Returns
+    -------
+    x : ndarray, shape (n_u,), or None
+        The solution, or ``None`` when the path did not reach ``lam = 1``.
+    iterations : int
+        Residual evaluations spent.
+    why : str
+        ``""``, or how the path ended.
+    """
+    def fun_h(xl):
+        R, J = fun(xl[:-1])
+        return R - (1.0 - xl[-1]) * R0, np.hstack([J, R0[:, None]])
+
+    path = Arclength(fun_h, np.zeros(scale.size + 1), scale=np.r_[scale, 1.0], lam_bounds=(-1.0, 1.0),
+                     options=ArclengthOptions(max_steps=max_steps, ds0=0.05), overwrite_jacobian=True,
+                     describe_lam=lambda lam: f"{lam:.0%} of the excitation")
+    end = None
+    for pt in path:
+        end = pt
+        if pt.on_bound:
+            break
+    if end is None or not end.on_bound or end.lam < 1.0:
+        return None, path.n_eval, f"arclength ramp: {path.message or 'left at ' + path.status}"
+    res = newton(fun, end.y, scale=scale, r_scale=r_scale)
+    if not res.converged:
+        return None, path.n_eval + res.iterations, f"arclength ramp reached 100 %, then {res.message}"
+    return res.x, path.n_eval + res.iterations, ""
 
 
 def _residual_scale(problem, w) -> float:

@@ -70,7 +70,9 @@ ELEMENTS = {
     "jenkins": {"kt": "tangential stiffness, N/m", "slip_force": "slip force, N"},
     "friction3d": {"kt": "tangential stiffness, N/m", "kn": "normal stiffness, N/m",
                    "mu": "friction coefficient", "normal_preload": "static normal load N0 >= 0, N "
-                   "(the contact opens when N0 + kn u_n falls to 0)"},
+                   "(the contact opens when N0 + kn (u_n - g) falls to 0)",
+                   "normal_gap": "optional initial normal gap g, m (default 0): > 0 open at rest, "
+                   "< 0 an interference (static load N0 - kn g)"},
     "coulomb_stick_slip": {"kt": "stick stiffness, N/m", "normal_load": "normal load, N",
                            "mu_static": "static friction coefficient",
                            "mu_kinetic": "kinetic friction coefficient"},
