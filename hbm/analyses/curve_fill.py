@@ -55,7 +55,7 @@ def fill_long_steps(problem, pts, segments, outputs_of, window, xscale, r_scale)
     ----------
     problem
         The FRF's problem.
-    pts : hbm.analyses.response._Path
+    pts : hbm.analyses.trace._Path
         Traced points, changed in place.
     segments : list of [int, int]
         ``[start, end)`` of each traced segment, shifted by every insertion.

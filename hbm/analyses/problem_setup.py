@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from continuation import Arclength, ArclengthOptions
+from hbm.analyses.bounded import unbounded_modes
 from hbm.analyses.budget import check_memory
 from hbm.interface.case import Case, CaseError
 from hbm.balance.condensed import condensed_balance
@@ -90,6 +91,17 @@ def choose_solver(case: Case) -> str:
         return s
     st = case.structure
     return "condensed" if st.sparse or st.n_dof > AUTO_CONDENSE_DOF else "full"
+
+
+def check_bounded(case: Case, lo_hz: float, hi_hz: float) -> None:
+    """Raise :class:`CaseError` when the window ``[lo_hz, hi_hz]`` holds a resonance that the
+    friction cannot bound (:mod:`hbm.analyses.bounded`): the FRF would be infinite there.
+    Made for the full solver without support motion (the test needs the whole model)."""
+    if choose_solver(case) != "full" or case.excitation.base is not None:
+        return
+    for m in unbounded_modes(case.model, case.elements, case.excitation.force, case.excitation.force_sine):
+        if lo_hz <= m.freq_hz <= hi_hz:
+            raise CaseError(f"{case.path}: {m.describe()}")
 
 
 def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: float | None = None):

@@ -1,0 +1,246 @@
+r"""Tracing one FRF window: first point, continuation, restarts past stops, and the branches
+that leave it.
+
+:func:`trace_window` solves a first point at ``fmin`` (:func:`hbm.analyses.problem_setup._first_point`),
+traces the branch upwards by :class:`continuation.Arclength` (:func:`_trace`: every point's
+energy balance checked, loose ones polished), restarts past a stop the corrector cannot
+pass (:func:`_restart_past_stops`, every skipped stretch stated), and traces from ``fmax``
+down what a branch folding back out at ``fmin`` leaves.  When no first point converges at
+``fmin`` (a stiff contact in stick-slip there, where Newton, the force ramp and its
+arclength version all fail), the window is traced from ``fmax`` down instead, and the
+message says so.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from continuation import Arclength
+from continuation.linsolve import REUSE_MIN_SIZE, ReusedLU
+
+from hbm.analyses.problem_setup import _first_point, recover_outputs
+from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
+from hbm.balance.energy import energy_balance
+from hbm.balance.newton import newton
+
+POLISH_ENERGY = 1e-10
+# a point whose energy balance stays looser than this after polishing is not a solution
+# the FRF can report: the path ends before it (status failed, the point named)
+ENERGY_LIMIT = 1e-8
+def _polish(problem, X, w, xscale, r_scale, err, linear_solve=None):
+    """Newton at fixed ``w`` on a point whose energy balance is not closed.
+
+    The continuation's tolerance is relative to the Jacobian's row norm, which a stiff
+    contact (kt >> k) makes large against the excitation: such a point can be accepted with
+    ``|R| / |F|`` ~ 1e-9 and an energy error ~ 1e-6.  Here the target is relative to ``|F|``.
+    Returns the better of the two points and its relative energy error.  ``linear_solve``:
+    Newton's linear solver (:func:`hbm.balance.newton.newton`), one kept LU shared by a path's polishes.
+    """
+    fun = lambda u: problem.residual(problem.expand(u), w)[:2]
+    res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4,
+                 linear_solve=linear_solve)
+    if np.all(np.isfinite(res.x)):
+        Xp = problem.expand(res.x)
+        err_p = energy_balance(problem, Xp, w).relative_error
+        if err_p < err:
+            return Xp, err_p
+    return X, err
+
+
+
+
+class _Path:
+    """Converged points of a traced path: coefficients, frequencies, outputs, iterations, errors."""
+
+    def __init__(self):
+        self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
+
+    def extend_reversed(self, other: "_Path") -> None:
+        for name in ("X", "w", "Y", "its", "err", "unclosed"):
+            getattr(self, name).extend(getattr(other, name)[::-1])
+
+
+def _widened_scale(problem, xscale: np.ndarray, X0: np.ndarray) -> np.ndarray:
+    """The unknowns' scale (n_unknowns,) raised, unknown DOF by unknown DOF, to the first
+    point's largest harmonic coefficient ``max_{k: h > 0} |X0[k, j]|`` where that is larger.
+
+    The scale from the linear limits (geometric mean of the stuck and free peaks) is far below
+    the response when a stiff contact slips from the start: with ``kt / k = 1e6`` it is
+    ``1e-3`` of the free peak, so every arclength step moved the frequency by ``3e-5 Hz`` and
+    den Hartog's oscillator (kt = 1e6, a 0.08 Hz window) stopped at ``max_points``."""
+    nc = X0.shape[0]
+    vib = problem.basis.h_of_row > 0        # a static offset (an interference) is not a motion
+    amp = np.abs(problem.unknowns(X0).reshape(nc, -1)[vib]).max(axis=0, initial=0.0)
+    return np.maximum(xscale, np.tile(amp, nc))
+
+
+def _step_limit(problem, case, window) -> ResonanceStepLimit:
+    """The FRF's parameter-step limit at the linear resonances of the free and stuck limits
+    (:mod:`hbm.analyses.resonances`) inside ``window`` (rad/s)."""
+    d = np.ix_(problem.modal_rows(), problem.modal_rows())
+    om, z = linear_resonances(problem.modal_data(), problem.stuck_stiffness()[d], problem.stuck_damping()[d])
+    return ResonanceStepLimit(om, z, window)
+
+
+def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, opts, progress, offset=0,
+           lam_step=None):
+    """One continuation from ``(X0, w0)`` in ``direction``; appends to ``pts``.
+
+    Returns ``(status, message, folds_hz, n_rejected)``.  Points whose energy balance is
+    looser than ``POLISH_ENERGY`` are polished by a fixed-frequency Newton solve; a point
+    still looser than ``ENERGY_LIMIT`` ends the path (status ``failed``, not kept).
+    """
+    scale = np.r_[xscale, bounds[1] - bounds[0]]
+    solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
+                       direction=direction, options=opts, lam_step=lam_step, overwrite_jacobian=True,
+                       describe_lam=lambda lam: f"{lam / (2 * np.pi):.6g} Hz")
+    polish_solve = ReusedLU() if problem.n_unknowns >= REUSE_MIN_SIZE else None
+    for pt in solver:
+        X = problem.expand(pt.x[:-1])
+        w = float(pt.x[-1])
+        err = energy_balance(problem, X, w).relative_error
+        if err > POLISH_ENERGY:
+            X, err = _polish(problem, X, w, xscale, r_scale, err, polish_solve)
+        if err > ENERGY_LIMIT:
+            return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
+                    f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "
+                    f"after polishing); the {len(pts.w)} points before it are kept",
+                    [f / (2 * np.pi) for f in solver.folds], solver.n_rejected)
+        pts.X.append(X)
+        pts.w.append(w)
+        pts.Y.append(recover_outputs(problem, case, X, w))
+        pts.its.append(pt.iterations if pts.w[1:] else it0 + pt.iterations)
+        pts.err.append(err)
+        pts.unclosed.append(problem.nl.last_unclosed)    # of the energy balance's force call at X
+        if progress is not None:
+            progress(offset + len(pts.w), w / (2 * np.pi))
+        if offset + len(pts.w) >= case.analysis.max_points:
+            break
+    return solver.status, solver.message, [f / (2 * np.pi) for f in solver.folds], solver.n_rejected
+
+
+GAP_FIRST = 1e-3        # first restart this share of the window past a stop, doubled per try
+GAP_TRIES = 8
+MAX_GAPS = 10
+
+
+def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, opts, progress, lam_step,
+                        outcome, settings):
+    """Where the continuation stopped inside the window, solve a fresh point a little further
+    (``GAP_FIRST`` of the window, doubled up to ``GAP_TRIES`` times) and trace on from it.
+
+    A stop at a stick-slip discontinuity (static above kinetic friction) or a corner the
+    corrector cannot turn leaves the rest of the window untraced; restarting past it gives the
+    user the rest, and every skipped stretch is stated: ``settings["gaps"]`` (from, to, why)
+    and a ``gap_warning``.  Returns the last segment's ``(status, message, folds, n_rejected)``.
+    """
+    status, message, folds, n_rej = outcome
+    w_lo, w_hi = window
+    gaps = []
+    while (status == "failed" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9) and len(gaps) < MAX_GAPS
+           and len(pts.w) < case.analysis.max_points):
+        w_from, restart = pts.w[-1], None
+        for k in range(GAP_TRIES):
+            w_r = min(w_from + GAP_FIRST * 2 ** k * (w_hi - w_lo), w_hi)
+            try:
+                Xr, itr = _first_point(problem, case, w_r, xscale, r_scale)
+            except RuntimeError:
+                if w_r == w_hi:
+                    break
+                continue
+            if energy_balance(problem, Xr, w_r).relative_error <= ENERGY_LIMIT:
+                restart = (Xr, itr, w_r)
+                break
+            if w_r == w_hi:
+                break
+        if restart is None:
+            message += "; no restart past it converged"
+            break
+        gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": restart[2] / (2 * np.pi), "reason": message})
+        start = len(pts.w)
+        status, message, f2, r2 = _trace(problem, case, pts, restart[0], restart[1], restart[2], (w_lo, w_hi), +1,
+                                         xscale, r_scale, opts, progress, offset=0, lam_step=lam_step)
+        folds, n_rej = folds + f2, n_rej + r2
+        segments.append([start, len(pts.w)])
+    if gaps:
+        settings["gaps"] = gaps
+        where = ", ".join(f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz" for g in gaps)
+        settings["gap_warning"] = (f"the continuation stopped {len(gaps)} time(s) and was restarted further on; "
+                                   f"not traced: {where} (first stop: {gaps[0]['reason']})")
+    return status, message, folds, n_rej
+
+
+def trace_window(problem, case, window, xscale, r_scale, opts, progress, settings):
+    """The points of the FRF over ``window`` (rad/s), lowest frequency first.
+
+    Returns
+    -------
+    pts : _Path
+    segments : list of [start, stop]
+        Index ranges of ``pts`` traced as one continuation each.
+    outcome : tuple
+        ``(status, message, folds_hz, n_rejected)`` of the run.
+    xscale : ndarray, shape (n_unknowns,)
+        The unknowns' scale, widened by the first point (:func:`_widened_scale`).
+    """
+    w_lo, w_hi = window
+    lo, hi = w_lo / (2 * np.pi), w_hi / (2 * np.pi)
+    pts, segments = _Path(), []
+    lam_step = _step_limit(problem, case, window)
+    try:
+        X0, it0 = _first_point(problem, case, w_lo, xscale, r_scale)
+    except RuntimeError as exc:
+        return _from_the_top(problem, case, window, xscale, r_scale, opts, progress, lam_step, str(exc))
+    xscale = _widened_scale(problem, xscale, X0)
+    outcome = _trace(problem, case, pts, X0, it0, w_lo, window, +1, xscale, r_scale, opts, progress,
+                     lam_step=lam_step)
+    segments.append([0, len(pts.w)])
+    status, message, folds, n_rej = _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale,
+                                                        opts, progress, lam_step, outcome, settings)
+    if status == "finished" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9):
+        # the branch folded back out of the window at fmin (e.g. a softening upper branch):
+        # the rest of the window lies on another branch, traced from fmax downwards
+        first_msg = (f"the branch from {lo:.6g} Hz folded back to {pts.w[-1] / (2 * np.pi):.6g} Hz; "
+                     f"traced the rest from {hi:.6g} Hz down")
+        part = _Path()
+        try:
+            Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
+        except RuntimeError as exc:
+            status, message = "failed", f"{first_msg}, but: {exc}"
+        else:
+            st2, msg2, f2, r2 = _trace(problem, case, part, Xh, ith, w_hi, window, -1, xscale,
+                                       r_scale, opts, progress, offset=len(pts.w), lam_step=lam_step)
+            folds, n_rej = folds + f2, n_rej + r2
+            if st2 == "finished" and part.w and part.w[-1] > w_lo * (1 + 1e-9):
+                st2 = "failed"
+                msg2 = (f"the FRF between {part.w[-1] / (2 * np.pi):.6g} Hz and the first branch is not "
+                        f"traced: the branch from {hi:.6g} Hz folded back too")
+            status, message = st2, f"{first_msg}: {msg2}"
+            segments.append([len(pts.w), len(pts.w) + len(part.w)])
+            pts.extend_reversed(part)
+    if len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
+        status = "max_steps"
+        message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[-1] / (2 * np.pi):.6g} Hz"
+    return pts, segments, (status, message, folds, n_rej), xscale
+
+
+def _from_the_top(problem, case, window, xscale, r_scale, opts, progress, lam_step, why):
+    """:func:`trace_window` when ``fmin``'s first point did not converge (``why``): the window
+    from ``fmax`` down, the points returned lowest frequency first."""
+    w_lo, w_hi = window
+    hi = w_hi / (2 * np.pi)
+    pts, part = _Path(), _Path()
+    try:
+        Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
+    except RuntimeError as exc:
+        return pts, [], ("failed", f"{why}; from {hi:.6g} Hz neither: {exc}", [], 0), xscale
+    xscale = _widened_scale(problem, xscale, Xh)
+    status, message, folds, n_rej = _trace(problem, case, part, Xh, ith, w_hi, window, -1, xscale, r_scale,
+                                           opts, progress, lam_step=lam_step)
+    pts.extend_reversed(part)
+    if status == "finished" and part.w and part.w[-1] > w_lo * (1 + 1e-9):
+        status, message = "failed", f"the branch from {hi:.6g} Hz folded back out of the window at {hi:.6g} Hz"
+    elif len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
+        status = "max_steps"
+        message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[0] / (2 * np.pi):.6g} Hz"
+    note = f"{why}; traced from {hi:.6g} Hz down instead"
+    return pts, [[0, len(pts.w)]], (status, f"{note}: {message}", folds, n_rej), xscale
