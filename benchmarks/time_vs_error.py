@@ -59,6 +59,16 @@ def cpu(fun, repeat=3):
     return best, out
 
 
+def write_rows(out, rows):
+    """``rows`` (dicts with the same keys) as the CSV file ``out``."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with open(out, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print(f"wrote {out}")
+
+
 # ----------------------------------------------------------------------------- cases
 def sdof_case(H=7, N=128):
     return case_from_dict({

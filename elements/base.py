@@ -82,6 +82,7 @@ class Element:
     quantities: tuple = ()      # names of the per-period outputs of ``summary``
     default_harmonics: int = 5          # H of a case that gives none (class docstring)
     default_samples_factor: int = 1     # N = factor * (power of two >= 8 H, >= 64)
+    aft: str = "sampled"        # "events": the AFT calls harmonic_forces (elements.jenkins)
 
     def __init__(self, gather, params, name):
         G = np.array(gather, dtype=float, ndmin=2)

@@ -26,6 +26,7 @@ import numpy as np
 
 from hbm.balance.aft_kernel import aft_law
 from hbm.balance.fourier import FourierBasis
+from elements.jenkins_events import row_kinds
 
 
 def _seeds(basis: FourierBasis, n_local: int, dE: bool) -> np.ndarray:
@@ -78,7 +79,7 @@ class NonlinearForces:
         compiled = getattr(transform, "name", "") == "dft"
         self._parts = []
         for e, G in zip(self.elements, self._G):
-            parts = e.law_parts() if compiled else None
+            parts = e.law_parts() if compiled and e.aft == "sampled" else None
             self._parts.append(None if parts is None else
                                [(np.ascontiguousarray(G[rows]), spec) for rows, spec in parts])
         rows0 = np.flatnonzero(basis.h_of_row == 0)
@@ -86,6 +87,7 @@ class NonlinearForces:
         self._E = np.ascontiguousarray(basis.E)
         self._dE = np.ascontiguousarray(basis.dE)
         self._P = np.ascontiguousarray(basis.P)
+        self._kinds = row_kinds(basis.h_of_row)
         for e, parts in zip(self.elements, self._parts):
             if parts is not None:
                 continue
@@ -149,6 +151,13 @@ class NonlinearForces:
                 continue
             nl = e.n_local
             U = Xnl @ G.T
+            exact = e.harmonic_forces(U, *self._kinds) if e.aft == "events" else None
+            if exact is not None:
+                Fe, dU = exact
+                F += Fe @ G
+                T = np.matmul(G.T, dU)
+                J4 += (T.reshape(nc * nn * nc, nl) @ G).reshape(nc, nn, nc, nn)
+                continue
             u = self.transform.synthesize(U)
             if e.velocity:
                 du_dth = self.basis.dE @ U
@@ -182,8 +191,13 @@ class NonlinearForces:
                 for Gp, sp in parts:
                     unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F) < 0
                 continue
+            e = self.elements[i]
+            exact = e.harmonic_forces(Xnl @ self._G[i].T, *self._kinds) if e.aft == "events" else None
+            if exact is not None:
+                F += exact[0] @ self._G[i]
+                continue
             z = self.element_samples(Xnl, w, i)
-            f, _ = self.elements[i].march(z, np.zeros(z.shape + (1,)))
+            f, _ = e.march(z, np.zeros(z.shape + (1,)))
             F += self.transform.analyse(f) @ self._G[i]
         self.last_unclosed = int(unclosed)
         return F

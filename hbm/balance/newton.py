@@ -7,7 +7,10 @@ Solves ``R(x) = 0`` for a square system.  With the diagonal scaling ``x = S y`` 
     \Delta y = -(J S)^{-1} R, \qquad x \leftarrow x + \alpha S \Delta y,
 
 with ``alpha`` halved until ``||R||`` decreases (Armijo-like), and convergence when
-``||R|| <= tol * r_scale``; the converged point gets one more update with the Jacobian at
+``||R|| <= tol * r_scale``, or when the residual has reached its round-off floor: the step
+``||Delta y||_inf <= 16 eps (1 + ||y||_inf)`` with ``||R|| <= sqrt(tol) r_scale`` (a stiff
+contact's forces ``k_t u`` carry round-off ``k_t |u| eps`` that can exceed ``tol * r_scale``;
+the same rule as the continuation's corrector).  The converged point gets one more update with the Jacobian at
 hand (polish; the reported residual is the one before it).  The result always carries a status
 and a message: it never fails silently.
 """
@@ -18,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from continuation.linsolve import REUSE_MIN_SIZE, ReusedLU, direct_solve
+
+_EPS = np.finfo(float).eps
 
 
 @dataclass(frozen=True)
@@ -74,6 +79,7 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
     R, J = fun(x)
     r = float(np.linalg.norm(R))
     target = tol * max(r_scale, 1e-300)
+    floor_ok = np.sqrt(tol) * max(r_scale, 1e-300)
     for it in range(1, max_iter + 1):
         if not np.all(np.isfinite(R)):
             return NewtonResult(x, False, it - 1, np.inf, "residual is not finite")
@@ -83,6 +89,8 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
         if dy is None or not np.all(np.isfinite(dy)):
             return NewtonResult(x, False, it - 1, r, "singular Jacobian")
         dy = dy[:, 0]
+        if r <= floor_ok and np.max(np.abs(dy)) <= 16 * _EPS * (1.0 + np.max(np.abs(x / S))):
+            return NewtonResult(x + S * dy, True, it - 1, r, "converged (residual at its round-off floor)")
         alpha = 1.0
         while True:
             xt = x + alpha * S * dy

@@ -67,7 +67,10 @@ ELEMENT_KEYS = {
 }
 
 ELEMENTS = {
-    "jenkins": {"kt": "tangential stiffness, N/m", "slip_force": "slip force, N"},
+    "jenkins": {"kt": "tangential stiffness, N/m", "slip_force": "slip force, N",
+                "aft": "`\"sampled\"` (default: the law marched over the time samples) or "
+                       "`\"events\"` (forces integrated exactly between the reversal and slip "
+                       "events: no sampling error, for stiff contacts and the Coulomb limit)"},
     "friction3d": {"kt": "tangential stiffness, N/m", "kn": "normal stiffness, N/m",
                    "mu": "friction coefficient", "normal_preload": "static normal load N0 >= 0, N "
                    "(the contact opens when N0 + kn (u_n - g) falls to 0)",

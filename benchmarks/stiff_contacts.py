@@ -1,0 +1,111 @@
+"""The stiff and separating contacts of the issue on stopping short, run as a new user would.
+
+Each case runs ``hbm.frf`` with its defaults (stability off, as the issue ran them) and, for
+the Jenkins cases, once more with ``aft = "events"`` (exact switches, no sampling).  Printed and
+written to benchmarks/results/stiff_contacts.csv: status, points, largest energy-balance
+error, CPU seconds, and for the Jenkins SDOF with viscous damping the largest error against
+den Hartog's closed form (viscous + Coulomb, continuous motion) over the window.
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/stiff_contacts.py
+"""
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import hbm                                      # noqa: E402
+from den_hartog import den_hartog               # noqa: E402
+from hbm.interface.case import case_from_dict   # noqa: E402
+from time_vs_error import write_rows            # noqa: E402
+
+
+def jenkins_sdof(kt, H, c, aft):
+    """m = k = 1, Jenkins (kt, slip 0.9) to ground, force 1, from 0.5 rad/s to 1.5 x the stuck
+    resonance (a window the bounded test passes: 0.9 > pi/4)."""
+    f_hi = 1.5 * math.sqrt(1.0 + kt) / (2 * math.pi)
+    return case_from_dict({
+        "model": {"mass": [[1.0]], "stiffness": [[1.0]], "damping": [[c]]},
+        "element": [{"type": "jenkins", "dofs": [0], "kt": kt, "slip_force": 0.9, "aft": aft}],
+        "excitation": {"dofs": [0], "amplitude": [1.0]},
+        "analysis": {"harmonics": H, "frequency_hz": [0.5 / (2 * math.pi), f_hi], "outputs": {"x": 0}},
+    })
+
+
+def chain3(kt, aft):
+    """Unit masses and springs (ground-m0-m1-m2), 1 % damping, Jenkins m0-ground and m1-m2
+    (kt, slip 1), force 0.5 on m2."""
+    K = [[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]]
+    Ks = np.array(K) + kt * np.array([[1, 0, 0], [0, 1, -1], [0, -1, 1]])
+    f_hi = 1.5 * math.sqrt(np.linalg.eigvalsh(Ks).max()) / (2 * math.pi)
+    return case_from_dict({
+        "model": {"mass": np.eye(3).tolist(), "stiffness": K, "damping": (0.02 * np.eye(3)).tolist()},
+        "element": [{"type": "jenkins", "dofs": [0], "kt": kt, "slip_force": 1.0, "aft": aft},
+                    {"type": "jenkins", "dofs": [1, 2], "kt": kt, "slip_force": 1.0, "aft": aft}],
+        "excitation": {"dofs": [2], "amplitude": [0.5]},
+        "analysis": {"harmonics": 7, "frequency_hz": [0.25 / (2 * math.pi), f_hi], "outputs": {"x2": 2}},
+    })
+
+
+def point_contact(n0, kn):
+    """Unit masses and springs in t (dof 0) and n (dof 1), 1 % damping, friction3d kt = 100,
+    mu 0.5, force 1 on both."""
+    f_hi = 1.5 * math.sqrt(1.0 + max(100.0, kn)) / (2 * math.pi)
+    return case_from_dict({
+        "model": {"mass": np.eye(2).tolist(), "stiffness": np.eye(2).tolist(), "damping": (0.02 * np.eye(2)).tolist()},
+        "element": [{"type": "friction3d", "dofs": {"t1": 0, "n": 1}, "kt": 100.0, "kn": kn, "mu": 0.5,
+                     "normal_preload": n0}],
+        "excitation": {"dofs": [0, 1], "amplitude": [1.0, 1.0]},
+        "analysis": {"frequency_hz": [0.5 / (2 * math.pi), f_hi], "outputs": {"t": 0, "n": 1}},
+    })
+
+
+def den_hartog_error(res, c):
+    errs = []
+    for f, a in zip(res.freq_hz, res.outputs["x"].max):
+        try:
+            A, _ = den_hartog(1.0, c, 1.0, 0.9, 1.0, 2 * math.pi * f)
+        except ValueError:
+            continue            # the mass sticks: the closed form does not apply
+        errs.append(abs(a / A - 1))
+    return max(errs) if errs else float("nan")
+
+
+def cases():
+    for aft in ("sampled", "events"):
+        for kt, H in ((1e4, 7), (1e5, 15), (1e6, 25)):
+            yield f"jenkins sdof c=0 kt={kt:g} H={H} {aft}", jenkins_sdof(kt, H, 0.0, aft), None
+        for H in (7, 15, 25):
+            yield f"jenkins sdof c=0.1 kt=1e5 H={H} {aft}", jenkins_sdof(1e5, H, 0.1, aft), 0.1
+        for kt in (1e3, 1e4):
+            yield f"chain3 kt={kt:g} {aft}", chain3(kt, aft), None
+    for n0, kn in ((0.5, 10.0), (0.1, 100.0), (50.0, 1e3)):
+        yield f"friction3d N0={n0:g} kn={kn:g}", point_contact(n0, kn), None
+
+
+def main():
+    rows = []
+    for name, case, c in cases():
+        t = time.process_time()
+        res = hbm.frf(case, stability=False)
+        dt = time.process_time() - t
+        err = den_hartog_error(res, c) if c is not None and res.freq_hz.size else float("nan")
+        row = dict(case=name, status=res.status, points=int(res.freq_hz.size),
+                   energy_max=float(np.max(res.energy_error)) if res.freq_hz.size else float("nan"),
+                   cpu_s=round(dt, 2), den_hartog_max_err=err, message=res.message)
+        rows.append(row)
+        print(f"{name:42s} {res.status:9s} {row['points']:5d} pts  energy {row['energy_max']:.1e}  "
+              f"{dt:6.2f} s  den Hartog {err:.2e}  {res.message[:90]}", flush=True)
+    write_rows(ROOT / "benchmarks" / "results" / "stiff_contacts.csv", rows)
+
+
+if __name__ == "__main__":
+    main()
