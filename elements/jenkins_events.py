@@ -70,6 +70,7 @@ def _phi(h, is_sin, theta, order, out):
 
 @nb.njit(cache=True)
 def _dot_phi(h, is_sin, U, theta, order, work):
+    """``d^order u / dtheta^order`` at ``theta`` (``work``: scratch of shape (nc,))."""
     _phi(h, is_sin, theta, order, work)
     v = 0.0
     for r in range(h.size):
