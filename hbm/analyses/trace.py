@@ -54,9 +54,11 @@ class _Path:
     def __init__(self):
         self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
 
-    def extend_reversed(self, other: "_Path") -> None:
+    def extend_reversed(self, other: "_Path", skip_first: bool = False) -> None:
+        """Append ``other``'s points in reverse order (without its first point if ``skip_first``)."""
+        k = 1 if skip_first else 0
         for name in ("X", "w", "Y", "its", "err", "unclosed"):
-            getattr(self, name).extend(getattr(other, name)[::-1])
+            getattr(self, name).extend(getattr(other, name)[k:][::-1])
 
 
 def _widened_scale(problem, xscale: np.ndarray, X0: np.ndarray) -> np.ndarray:
@@ -126,7 +128,8 @@ MAX_GAPS = 10
 def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, opts, progress, lam_step,
                         outcome, settings):
     """Where the continuation stopped inside the window, solve a fresh point a little further
-    (``GAP_FIRST`` of the window, doubled up to ``GAP_TRIES`` times) and trace on from it.
+    (``GAP_FIRST`` of the window, doubled up to ``GAP_TRIES`` times), trace back from it
+    towards the stop (what that reaches is not a gap) and on from it.
 
     A stop at a stick-slip discontinuity (static above kinetic friction) or a corner the
     corrector cannot turn leaves the rest of the window untraced; restarting past it gives the
@@ -155,8 +158,15 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
         if restart is None:
             message += "; no restart past it converged"
             break
-        gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": restart[2] / (2 * np.pi), "reason": message})
         start = len(pts.w)
+        # back from the restart towards the stop, so that only what neither side reaches is a gap
+        back = _Path()
+        _trace(problem, case, back, restart[0], restart[1], restart[2], (w_from, w_hi), -1, xscale, r_scale,
+               opts, progress, offset=len(pts.w), lam_step=lam_step)
+        pts.extend_reversed(back, skip_first=True)
+        w_reached = min(back.w) if back.w else restart[2]
+        if w_reached > w_from * (1 + 1e-9):
+            gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": w_reached / (2 * np.pi), "reason": message})
         status, message, f2, r2 = _trace(problem, case, pts, restart[0], restart[1], restart[2], (w_lo, w_hi), +1,
                                          xscale, r_scale, opts, progress, offset=0, lam_step=lam_step)
         folds, n_rej = folds + f2, n_rej + r2
