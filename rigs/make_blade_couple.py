@@ -3,7 +3,8 @@
 Figures go to ``rigs/blade_couple/*.png`` (with the CSVs behind them); tables are written
 into the document between ``<!-- table:NAME -->`` and ``<!-- /table:NAME -->`` markers.
 Run from anywhere: ``python rigs/make_blade_couple.py`` (``make rigs`` runs it).  Takes a
-few minutes (about 80 FRFs and four time integrations of 4 s).
+few minutes (about 150 FRFs and four time integrations of 4 s); ``--lab`` runs only the
+studies with the laboratory's element mass (``rigs/blade_couple_lab.toml``).
 """
 from __future__ import annotations
 
@@ -38,6 +39,11 @@ FT_PAPER = [0.35, 0.4, 0.5, 0.6, 0.8]
 SWEEP_FT = [round(v, 2) for v in np.arange(0.3, 1.61, 0.1)]
 JENKINS = ContactLaw("jenkins", kt=1.0e6)
 ARCTAN = ContactLaw("arctan", v_r=0.01)
+# the laboratory's element mass (paper, Section 6): rigs/blade_couple_lab.toml
+LAB_MASS = [0.182, 0.182, 0.078]
+LAB_ANALYSIS = Analysis(harmonics=list(range(1, 16, 2)), samples=256)
+LAB_COULOMB = ContactLaw("jenkins", kt=1.0e6, aft="events")
+LAB_FT = [0.35, 0.5, 0.6, 0.8, 1.0, 1.5, 3.0]
 tables: dict = {}
 
 
@@ -201,6 +207,39 @@ def optimum_sweeps():
     tables["optimum"] = "\n".join(rows)
 
 
+def lab_optimum():
+    """The optimum Ft0 with the laboratory's element mass, at F0 = 1 N and at the lab's 0.8 N."""
+    rows = ["| law | m3 (kg) | F0 (N) | optimum Ft0 (N) | pi F0 / 4 (N) | a1 peak there (mm) | at f (Hz) "
+            "| a1 peak at Ft0 = 0.5 / 0.6 N (mm) | FRFs not finished |", "|---|---|---|---|---|---|---|---|---|"]
+    fts = [round(v, 2) for v in np.arange(0.3, 1.61, 0.05)]
+    for F0 in (1.0, 0.8):
+        sw = []
+        for ft in fts:
+            res = frf_of(with_contacts(load_rig(), LAB_COULOMB, ft, F0=F0, mass=LAB_MASS), LAB_ANALYSIS)
+            sw.append(peak_row(ft, res))
+            log(f"  lab sweep F0={F0} Ft0={ft}: a1 {sw[-1].a1_peak:.4e} ({sw[-1].status})")
+        write_csv(sw, OUT / f"sweep_lab_F0_{F0:g}.csv")
+        o = optimum(sw)
+        at = [fmt_mm(r.a1_peak) for r in sw if round(r.slip_force, 2) in (0.5, 0.6)]
+        bad = [f"{r.slip_force:g}" for r in sw if r.status != "finished"]
+        rows.append(f"| {LAB_COULOMB.label} | 0.078 | {F0:g} | {o.slip_force:g} | {math.pi * F0 / 4:.3f} | "
+                    f"{fmt_mm(o.a1_peak)} | {o.f_peak:.2f} | {' / '.join(at)} | {', '.join(bad) or 'none'} |")
+        plot([(LAB_COULOMB.label + ", m3 = 0.078 kg", sw)], OUT / f"optimum_lab_F0_{F0:g}.png", F0=F0)
+    tables["lab_optimum"] = "\n".join(rows)
+
+
+def lab_studies():
+    log("laboratory element mass m3 = 0.078 kg")
+    response_curves("lab_coulomb", LAB_COULOMB, "m3 = 0.078 kg: Coulomb contacts (Jenkins kt = 1e6 N/m, "
+                    "exact AFT), F0 = 1 N", fts=LAB_FT, analysis=LAB_ANALYSIS, mass=LAB_MASS)
+    response_curves("lab_coulomb_F0_0.8", LAB_COULOMB, "m3 = 0.078 kg: Coulomb contacts, the lab's F0 = 0.8 N",
+                    fts=[0.4, 0.5, 0.6, 0.65, 0.8], analysis=LAB_ANALYSIS, mass=LAB_MASS, F0=0.8)
+    response_curves("lab_stickslip", ContactLaw("jenkins", kt=50000.0, aft="events"),
+                    "m3 = 0.078 kg: stick-slip contacts (k = 50000 N/m + Coulomb), F0 = 1 N",
+                    fts=[0.35, 0.5, 0.8, 1.0, 1.5], analysis=LAB_ANALYSIS, mass=LAB_MASS)
+    lab_optimum()
+
+
 def envelope(t, y, T):
     """Max |y| over each excitation period: times (period ends) and amplitudes."""
     n = int(round(T / (t[1] - t[0])))
@@ -284,6 +323,11 @@ def update_doc():
 def main():
     OUT.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    if "--lab" in sys.argv[1:]:            # the laboratory-mass studies only
+        lab_studies()
+        update_doc()
+        log(f"done in {time.perf_counter() - t0:.0f} s")
+        return
     log("Coulomb contacts as stiff Jenkins elements (kt = 1e6 N/m)")
     response_curves("coulomb", JENKINS, "Coulomb contacts (Jenkins kt = 1e6 N/m), k3 = 1000 N/m, F0 = 1 N")
     log("stiffness and harmonic convergence")
@@ -302,6 +346,7 @@ def main():
     optimum_sweeps()
     log("free decay")
     decay()
+    lab_studies()
     update_doc()
     log(f"done in {time.perf_counter() - t0:.0f} s; wrote {OUT}/*.png and the tables of {DOC}")
 

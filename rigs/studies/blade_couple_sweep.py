@@ -47,12 +47,14 @@ LAWS = ("jenkins", "arctan", "linear")
 
 @dataclass(frozen=True)
 class ContactLaw:
-    """The law of both contacts: ``jenkins`` with stick stiffness ``kt`` (N/m), or the
-    velocity-regularised Coulomb law ``arctan`` / ``linear`` with ``v_r`` (m/s)."""
+    """The law of both contacts: ``jenkins`` with stick stiffness ``kt`` (N/m) and its AFT
+    (``aft``: ``sampled`` or ``events``), or the velocity-regularised Coulomb law ``arctan`` /
+    ``linear`` with ``v_r`` (m/s)."""
 
     kind: str = "jenkins"
     kt: float = 1.0e6
     v_r: float = 0.01
+    aft: str = "sampled"
 
     def __post_init__(self):
         if self.kind not in LAWS:
@@ -63,7 +65,7 @@ class ContactLaw:
     @property
     def label(self) -> str:
         if self.kind == "jenkins":
-            return f"Jenkins kt={self.kt:g} N/m"
+            return f"Jenkins kt={self.kt:g} N/m" + (" (events)" if self.aft == "events" else "")
         return f"{self.kind} Coulomb v_r={self.v_r:g} m/s"
 
 
@@ -109,7 +111,7 @@ def with_contacts(data: dict, law: ContactLaw, slip_force: float, **model) -> di
         e.clear()
         e.update(keep)
         if law.kind == "jenkins":
-            e.update(type="jenkins", kt=float(law.kt), slip_force=float(slip_force))
+            e.update(type="jenkins", kt=float(law.kt), slip_force=float(slip_force), aft=law.aft)
         else:
             e.update(type="coulomb_regularised", law=law.kind, v_r=float(law.v_r),
                      slip_force=float(slip_force))
