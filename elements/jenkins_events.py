@@ -56,11 +56,17 @@ def row_kinds(h_of_row):
 
 @nb.njit(cache=True)
 def _phi(h, is_sin, theta, order, out):
-    """``d^order phi / dtheta^order`` at ``theta`` into ``out`` (nc,)."""
+    """``d^order phi / dtheta^order`` at ``theta`` into ``out`` (nc,); the rows' harmonics
+    ascend, so ``cos h theta``, ``sin h theta`` come by rotation from ``cos theta``,
+    ``sin theta`` (two trigonometric calls, not ``2 nc``; error ``~ h eps``)."""
+    c1, s1 = math.cos(theta), math.sin(theta)
+    c, s, cur = 1.0, 0.0, 0
+    q = order % 4
     for r in range(h.size):
-        x = h[r] * theta
-        c, s = math.cos(x), math.sin(x)
-        q = order % 4
+        target = int(h[r])
+        while cur < target:
+            c, s = c * c1 - s * s1, s * c1 + c * s1
+            cur += 1
         if is_sin[r]:
             v = s if q == 0 else (c if q == 1 else (-s if q == 2 else -c))
         else:
@@ -100,11 +106,18 @@ def _means(h, is_sin, a, b, Ic, Is, C):
 @nb.njit(cache=True)
 def _phi_diff(h, is_sin, theta, a, out):
     """``phi(theta) - phi(a)`` into ``out`` (nc,) by the sum-to-product identities, exact to
-    round-off relative to the difference (not to ``phi``) when ``theta`` is near ``a``."""
+    round-off relative to the difference (not to ``phi``) when ``theta`` is near ``a``; the
+    half-sum and half-difference angles rotate harmonic by harmonic as in :func:`_phi`."""
+    cm1, sm1 = math.cos(0.5 * (theta + a)), math.sin(0.5 * (theta + a))
+    cd1, sd1 = math.cos(0.5 * (theta - a)), math.sin(0.5 * (theta - a))
+    cm, sm, cd, sd, cur = 1.0, 0.0, 1.0, 0.0, 0
     for r in range(h.size):
-        m = 0.5 * h[r] * (theta + a)
-        dh = math.sin(0.5 * h[r] * (theta - a))
-        out[r] = 2.0 * math.cos(m) * dh if is_sin[r] else -2.0 * math.sin(m) * dh
+        target = int(h[r])
+        while cur < target:
+            cm, sm = cm * cm1 - sm * sm1, sm * cm1 + cm * sm1
+            cd, sd = cd * cd1 - sd * sd1, sd * cd1 + cd * sd1
+            cur += 1
+        out[r] = 2.0 * cm * sd if is_sin[r] else -2.0 * sm * sd
 
 
 @nb.njit(cache=True)
