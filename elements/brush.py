@@ -59,8 +59,8 @@ import math
 
 import numpy as np
 
-from .base import (Element, LawSpec, coordinate_rows, require_keys, positive, non_negative, finite,
-                   principal_reversal)
+from .base import Element, LawSpec, principal_reversal
+from .keys import coordinate_rows, require_keys, positive, non_negative, finite
 from .friction3d import Friction3D
 from .hertz import hertz_contact
 from .laws.registry import FRICTION3D

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
+from .base import Element, slider_summary
+from .keys import coordinate_rows, require_keys, positive, non_negative
 from .laws.registry import COULOMB_STATIC_KINETIC, COULOMB_REGULARISED
 from .laws.coulomb import LINEAR, ARCTAN, TANH
 from .law_march import START_ARGMAX

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, finite, positive, non_negative
+from .base import Element
+from .keys import coordinate_rows, require_keys, finite, positive, non_negative
 from .law_march import START_PRINCIPAL, CLOSE_NEWTON
 from .laws.registry import FRICTION3D
 
@@ -17,7 +18,7 @@ class Friction3D(Element):
     (``g``, default 0) and ``name``.
 
     Each local coordinate is a linear combination of model DOFs, one row of the gather
-    matrix (:func:`elements.base.coordinate_row`):
+    matrix (:func:`elements.keys.coordinate_row`):
 
     - ``a`` or ``[a]``: ``q_a``;  ``[a, b]``: ``q_a - q_b`` (contact between two bodies whose
       DOFs are along the contact axes);

@@ -5,7 +5,8 @@ import functools
 
 import numpy as np
 
-from .base import Element, coordinate_rows, require_keys, positive, non_negative, slider_summary
+from .base import Element, slider_summary
+from .keys import coordinate_rows, require_keys, positive, non_negative
 from .laws.registry import JENKINS
 from .law_march import START_ARGMAX
 from .jenkins_events import gauss_table, jenkins_harmonics

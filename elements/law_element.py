@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate_rows, finite, non_negative, positive, require_keys
+from .base import Element
+from .keys import coordinate_rows, finite, non_negative, positive, require_keys
 
 _CHECK = {"positive": positive, "non_negative": non_negative, "finite": finite}
 

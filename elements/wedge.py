@@ -38,7 +38,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Element, coordinate
+from .base import Element
+from .keys import coordinate
 from .friction3d import Friction3D
 from .laws.registry import FRICTION3D
 from .wedge_params import KEYS, WedgeParams, parse_params, _sides

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .base import require_keys, positive, non_negative, finite
+from .keys import require_keys, positive, non_negative, finite
 from .wedge_statics import static_normal_loads
 
 KEYS = ("type", "name", "left", "right", "angles_deg", "mass", "inertia", "cf", "mu", "kt", "kn",

@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from elements.base import coordinate_row
+from elements.keys import coordinate_row
 
 from hbm.balance.fourier import parse_harmonics, min_samples, default_samples
 from hbm.model.linear import LinearModel
@@ -191,7 +191,7 @@ def _phases(t, k, path) -> np.ndarray:
 
 
 def _row(spec, model, coords, where, path) -> np.ndarray:
-    """Gather row (n,) of a coordinate spec (:func:`elements.base.coordinate_row`)."""
+    """Gather row (n,) of a coordinate spec (:func:`elements.keys.coordinate_row`)."""
     try:
         return coordinate_row(spec, model.n_dof, coords, where)
     except ValueError as exc:

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from elements.base import MAGNITUDE_MAX, did_you_mean
+from elements.keys import MAGNITUDE_MAX, did_you_mean
 
 
 class CaseError(ValueError):

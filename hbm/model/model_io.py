@@ -21,7 +21,7 @@ import numpy as np
 import scipy.io
 import scipy.sparse as sp
 
-from elements.base import MAGNITUDE_MAX
+from elements.keys import MAGNITUDE_MAX
 
 
 @dataclass(frozen=True)
