@@ -105,8 +105,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     shape = (basis.n_coef, problem.n_dof)
     pts, segments, (status, message, folds, n_rej), xscale = trace_window(
         problem, case, (w_lo, w_hi), xscale, r_scale, options or ArclengthOptions(), progress, settings)
-    def outputs_of(X, w):
-        return recover_outputs(problem, case, X, w)
+    outputs_of = lambda X, w: recover_outputs(problem, case, X, w)      # noqa: E731
     if len(pts.w) >= 2:
         settings["fill_points_added"] = fill_long_steps(problem, pts, segments, outputs_of, (w_lo, w_hi),
                                                         xscale, r_scale)
@@ -117,47 +116,18 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
     _closure_warning(settings, pts.unclosed, pts.w)
-    stable = None
-    if stability:
-        if progress is not None:
-            progress(len(pts_w), None)
-        stable, margin = path_verdicts(problem, pts_X, np.array(pts_w), segments, stability_options)
-        settings["stability_spectra"] = int(np.isfinite(margin).sum())
-        growth = margin / np.array(pts_w)
-        settings["stability_max_growth"] = float(np.nanmax(growth)) if np.isfinite(margin).any() else None
-        if np.nanmax(growth, initial=-np.inf) > IMPLAUSIBLE_GROWTH:
-            settings["stability_warning"] = (
-                f"Hill exponents grow by up to exp({2 * np.pi * np.nanmax(growth):.2g}) per period: "
-                f"typical of modes above the retained harmonics, not of a friction-damped response; "
-                f"check an unstable point with hbm timesim or raise the harmonics")
+    stable = _verdicts(problem, pts_X, pts_w, segments, stability_options, settings, progress) if stability else None
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
     n_out = len(case.analysis.outputs)
     Ys = np.array(pts_Y) if pts_Y else np.zeros((0, basis.n_coef, n_out))
-    outputs = {}
-    for i, name in enumerate(case.analysis.outputs):
-        yd = Ys[:, :, i]
-        if 1 in basis.harmonics and Ys.shape[0]:
-            rc = basis.row_of(1, "c")
-            h1 = np.hypot(yd[:, rc], yd[:, rc + 1])
-        else:
-            h1 = np.zeros(Ys.shape[0])
-        mx = max_abs(basis, yd.T)
-        outputs[name] = OutputSeries(h1, mx)
+    outputs = {name: OutputSeries(*_amplitudes(basis, Ys[:, :, i])) for i, name in enumerate(case.analysis.outputs)}
     freq_hz = np.array(pts_w) / (2 * np.pi)
     jumps = None
     if stable is not None:
         if choose_solver(case) == "full":
             stable = confirm_unstable(case, basis, Xs, freq_hz, stable, settings)
-        land = landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
-        jumps = {}
-        for i, name in enumerate(case.analysis.outputs):
-            def refine(i0, i1, f, i=i):
-                X = land(i0, i1, f)
-                if X is None:
-                    return None
-                return output_amplitudes(basis, recover_outputs(problem, case, X, 2 * np.pi * f)[:, i])[0]
-            jumps[name] = predict_jumps(freq_hz, outputs[name].h1, stable, folds, refine=refine)
+        jumps = _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, stability_options)
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
     if error_estimate and Xs.shape[0]:
         outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings)
@@ -167,6 +137,49 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
                      jumps, eouts, Ys, stuck)
+
+
+def _verdicts(problem, Xs, ws, segments, stability_options, settings, progress):
+    """Hill's verdict (n_points,) of every point (:func:`hbm.analyses.verdicts.path_verdicts`);
+    ``settings`` gains the spectra count, the largest growth and, where implausible, a warning."""
+    if progress is not None:
+        progress(len(ws), None)
+    stable, margin = path_verdicts(problem, Xs, np.array(ws), segments, stability_options)
+    settings["stability_spectra"] = int(np.isfinite(margin).sum())
+    growth = margin / np.array(ws)
+    settings["stability_max_growth"] = float(np.nanmax(growth)) if np.isfinite(margin).any() else None
+    if np.nanmax(growth, initial=-np.inf) > IMPLAUSIBLE_GROWTH:
+        settings["stability_warning"] = (
+            f"Hill exponents grow by up to exp({2 * np.pi * np.nanmax(growth):.2g}) per period: "
+            f"typical of modes above the retained harmonics, not of a friction-damped response; "
+            f"check an unstable point with hbm timesim or raise the harmonics")
+    return stable
+
+
+def _amplitudes(basis: FourierBasis, Y: np.ndarray):
+    """``(h1, max)`` of one output's coefficients at every point, ``Y`` (n_points, n_coef)."""
+    if 1 in basis.harmonics and Y.shape[0]:
+        rc = basis.row_of(1, "c")
+        h1 = np.hypot(Y[:, rc], Y[:, rc + 1])
+    else:
+        h1 = np.zeros(Y.shape[0])
+    return h1, max_abs(basis, Y.T)
+
+
+def _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, stability_options) -> dict:
+    """Per output, the jumps of slow up and down sweeps (:func:`hbm.analyses.jumps.predict_jumps`),
+    each landing point solved where it can be (:func:`hbm.analyses.verdicts.landing_solver`)."""
+    basis = problem.basis
+    land = landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options)
+    jumps = {}
+    for i, name in enumerate(case.analysis.outputs):
+        def refine(i0, i1, f, i=i):
+            X = land(i0, i1, f)
+            if X is None:
+                return None
+            return output_amplitudes(basis, recover_outputs(problem, case, X, 2 * np.pi * f)[:, i])[0]
+        jumps[name] = predict_jumps(freq_hz, outputs[name].h1, stable, folds, refine=refine)
+    return jumps
 
 
 def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
