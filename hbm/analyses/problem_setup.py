@@ -177,14 +177,16 @@ def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
     return np.tile(s, problem.basis.n_coef)
 
 
-def _first_point(problem, case, w0, scale, r_scale):
+def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
     """Converged first point ``X`` (n_coef, n) at ``w0``, or raise RuntimeError with the reason.
 
     Newton from the linear response with the elements stuck, then without them; failing
     both, the Newton homotopy ``H(x, lam) = R(x) - (1 - lam) R(0)`` from ``lam = 0`` (solved
     by ``x = 0``) to ``lam = 1``: first in fixed steps of ``lam``, then, if a step fails (the
     homotopy path folds back in ``lam``: a contact that closes or a jump up the resonance),
-    traced by pseudo-arclength continuation through its folds (:func:`_homotopy_path`).
+    traced by pseudo-arclength continuation through its folds (:func:`_homotopy_path`) unless
+    ``arclength_ramp`` is False (a restart past a stop, which tries several frequencies: there
+    the traced ramp cost half the run on the cross beam and found nothing the next try did not).
     """
     fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
     guesses = [problem.linear_solution(w0, problem.stuck_stiffness()), problem.linear_solution(w0)]
@@ -209,7 +211,7 @@ def _first_point(problem, case, w0, scale, r_scale):
     else:
         return problem.expand(x), its
     ramp = f"ramp stopped at {lam:.0%} of the excitation: {res.message}"
-    x, its_h, why = _homotopy_path(fun, R0, scale, r_scale)
+    x, its_h, why = _homotopy_path(fun, R0, scale, r_scale) if arclength_ramp else (None, 0, "no arclength ramp")
     if x is None:
         raise RuntimeError(f"first point at {w0 / (2 * np.pi):.6g} Hz did not converge "
                            f"(linear starts: {last.message}; {ramp}; {why})")

@@ -145,7 +145,7 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
         for k in range(GAP_TRIES):
             w_r = min(w_from + GAP_FIRST * 2 ** k * (w_hi - w_lo), w_hi)
             try:
-                Xr, itr = _first_point(problem, case, w_r, xscale, r_scale)
+                Xr, itr = _first_point(problem, case, w_r, xscale, r_scale, arclength_ramp=False)
             except RuntimeError:
                 if w_r == w_hi:
                     break
