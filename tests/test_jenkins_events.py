@@ -135,3 +135,22 @@ def test_case_key():
     assert sdof(1e3, "events").elements[0].aft == "events"
     with pytest.raises(CaseError, match="aft"):
         sdof(1e3, "exact")
+
+
+def test_a_stopped_run_with_stiff_sampled_contacts_says_what_to_try():
+    """The hint `hbm frf` prints when a path stops or leaves gaps: stiff (kt >= 100 x the
+    structure along the contact), sampled Jenkins elements are named; events or soft ones not."""
+    from hbm.analyses.response import stiff_contact_hint
+
+    def case(kt, aft):
+        return case_from_dict({
+            "model": {"mass": [[1.0, 0.0], [0.0, 1.0]], "stiffness": [[2.0, -1.0], [-1.0, 2.0]]},
+            "element": [{"type": "jenkins", "dofs": [0, 1], "kt": kt, "slip_force": 0.9, "aft": aft, "name": "c"}],
+            "excitation": {"dofs": [0], "amplitude": [1.0]},
+            "analysis": {"harmonics": 5, "frequency_hz": [0.1, 0.2], "outputs": {"x": 0}},
+        })
+    # along u = q0 - q1 the structure's stiffness is g K g^T / g g^T = 6 / 2 = 3
+    assert "c: kt = 1e+03 x" in stiff_contact_hint(case(3e3, "sampled"))
+    assert 'aft = "events"' in stiff_contact_hint(case(3e3, "sampled"))
+    assert stiff_contact_hint(case(3e3, "events")) == ""
+    assert stiff_contact_hint(case(30.0, "sampled")) == ""

@@ -105,6 +105,10 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     shape = (basis.n_coef, problem.n_dof)
     pts, segments, (status, message, folds, n_rej), xscale = trace_window(
         problem, case, (w_lo, w_hi), xscale, r_scale, options or ArclengthOptions(), progress, settings)
+    if status != "finished" or settings.get("gaps"):
+        hint = stiff_contact_hint(case)
+        if hint:
+            settings["contact_hint"] = hint
     outputs_of = lambda X, w: recover_outputs(problem, case, X, w)      # noqa: E731
     if len(pts.w) >= 2:
         settings["fill_points_added"] = fill_long_steps(problem, pts, segments, outputs_of, (w_lo, w_hi),
@@ -137,6 +141,32 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
                      jumps, eouts, Ys, stuck)
+
+
+STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
+
+
+def stiff_contact_hint(case: Case) -> str:
+    """What to try when the path stopped and sampled Jenkins contacts are stiff (``kt`` at least
+    ``STIFF_CONTACT`` times the structure's stiffness ``g K g^T / g g^T`` along the contact):
+    their switches sit on the time grid, where Newton stalls, and ``aft = "events"`` locates
+    them exactly.  Empty when there is none (or the model is not dense)."""
+    if choose_solver(case) != "full":
+        return ""
+    K = case.model.K
+    stiff = []
+    for e in case.elements:
+        if type(e).__name__ != "Jenkins" or e.aft != "sampled":
+            continue
+        g = e.gather[0]
+        ks = float(g @ K @ g) / float(g @ g)
+        if ks > 0 and e.kt >= STIFF_CONTACT * ks:
+            stiff.append(f"{e.name}: kt = {e.kt / ks:.3g} x")
+    if not stiff:
+        return ""
+    return (f"stiff Jenkins contacts ({', '.join(stiff)} the structure's stiffness along them) are sampled "
+            f"on the time grid, where Newton stalls at their switches: aft = \"events\" on them locates the "
+            f"switches exactly (README, \"Stiff contacts\")")
 
 
 def _verdicts(problem, Xs, ws, segments, stability_options, settings, progress):

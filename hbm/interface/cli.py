@@ -183,7 +183,8 @@ def cmd_frf(args) -> int:
                          "check with hbm timesim)" if j["amplitude_after"] is None else f"{j['amplitude_after']:.6g}")
                 print(f"  jump {name} (sweep {way}) at {j['from_hz']:.6g} Hz: "
                       f"{j['amplitude_before']:.6g} -> {after}")
-    for key in ("gap_warning", "stability_warning", "closure_warning", "truncation_warning", "harmonics_note"):
+    for key in ("gap_warning", "contact_hint", "stability_warning", "closure_warning", "truncation_warning",
+                "harmonics_note"):
         if st.get(key):
             print(f"  warning: {st[key]}", file=sys.stderr)
     if summary["max_energy_error"] is not None:
