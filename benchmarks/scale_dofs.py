@@ -18,7 +18,6 @@ slows the small dense eigen-solves by orders of magnitude.
 from __future__ import annotations
 
 import argparse
-import csv
 import time
 import tomllib
 from pathlib import Path
@@ -26,6 +25,7 @@ from pathlib import Path
 from hbm.interface.case import case_from_dict
 from hbm.balance.fourier import FourierBasis
 from hbm.analyses.response import build_problem, frf
+from time_vs_error import write_rows         # benchmarks/ is the script's own folder
 
 HERE = Path(__file__).resolve().parent
 ELEMENTS_PER_BLADE = (10, 40, 100, 400, 1000, 4000, 8000)
@@ -75,13 +75,7 @@ def main(argv=None):
               f"{row['ratio']:>6.2f} {cpu:>8.3f} {row['cpu_ratio']:>6.2f} {row['points']:>6} {its:>6} "
               f"{row['ms_per_iteration']:>8.2f} "
               f"{row['peak_tip1']:>10.4g} {row['solver']:>9}", flush=True)
-    out = HERE / "results" / "scale_dofs.csv"
-    out.parent.mkdir(exist_ok=True)
-    with open(out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    print(f"wrote {out}")
+    write_rows(HERE / "results" / "scale_dofs.csv", rows)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,6 @@ Writes benchmarks/results/stability_cost.csv.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 import tomllib
 from pathlib import Path
@@ -23,7 +22,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import hbm                                      # noqa: E402
 from hbm.interface.case import case_from_dict, load_case  # noqa: E402
-from time_vs_error import cpu, target_case       # noqa: E402
+from time_vs_error import cpu, target_case, write_rows       # noqa: E402
 
 TARGETS = {"three_dof_two_jenkins": 0.5, "upd_rig": 1.0}
 
@@ -55,12 +54,7 @@ def main(argv=None):
               f"stability costs {ratio:.2f}x the solve{verdict}")
         rows.append(dict(case=name, points=int(r0.freq_hz.size), solve_s=round(t0, 4), with_stability_s=round(t1, 4),
                          ratio=round(ratio, 3), target="" if target is None else target))
-    out = ROOT / "benchmarks" / "results" / "stability_cost.csv"
-    with open(out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    print(f"wrote {out}")
+    write_rows(ROOT / "benchmarks" / "results" / "stability_cost.csv", rows)
 
 
 if __name__ == "__main__":

@@ -159,6 +159,13 @@ class Element:
                           self.start_index(z[:, :self.n_local]), self.max_passes, self.closure_tol)
         return f, df
 
+    @property
+    def slip_limit(self):
+        """The force a sliding element carries whatever its motion (N), or None when it has no
+        such fixed limit (a load that varies, a spring): used to bound a resonance
+        (:mod:`hbm.analyses.bounded`)."""
+        return None
+
     def linear_stiffness(self) -> np.ndarray:
         """Tangent stiffness (n_local, n_local) of the element at rest (stuck, closed)."""
         raise NotImplementedError

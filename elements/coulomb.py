@@ -49,6 +49,11 @@ class CoulombStickSlip(Element):
         return cls(G, spec["kt"], spec["normal_load"], spec["mu_static"], spec["mu_kinetic"],
                    spec.get("name", "coulomb_stick_slip"))
 
+    @property
+    def slip_limit(self):
+        """Sliding carries the kinetic force ``mu_kinetic N``."""
+        return float(self.params[1] * self.params[3])
+
     def linear_stiffness(self):
         stuck = self.params[1] * self.params[2] > 0.0
         return np.array([[self.params[0] if stuck else 0.0]])
@@ -92,6 +97,10 @@ class CoulombRegularised(Element):
         G = coordinate_rows([spec["dofs"]], n_dof, dof_index, where)
         return cls(G, spec["slip_force"], spec["v_r"], spec.get("law", "linear"),
                    spec.get("name", "coulomb_regularised"))
+
+    @property
+    def slip_limit(self):
+        return float(self.params[0])
 
     def linear_stiffness(self):
         return np.zeros((1, 1))

@@ -65,6 +65,10 @@ class Jenkins(Element):
     def slip_force(self):
         return float(self.params[1])
 
+    @property
+    def slip_limit(self):
+        return self.slip_force
+
     def linear_stiffness(self):
         return np.array([[self.kt]])
 

@@ -1,7 +1,7 @@
 r"""Unbounded resonances: den Hartog's condition for modes without viscous damping.
 
-When every element is a friction element with a fixed slip force :math:`F_{s,i}` (Jenkins,
-Coulomb) and a mode :math:`\phi_r` of the structure (``K phi = w_r^2 M phi``, the elements
+When every element is a friction element with a fixed slip force :math:`F_{s,i}` (its
+``slip_limit``: Jenkins, Coulomb) and a mode :math:`\phi_r` of the structure (``K phi = w_r^2 M phi``, the elements
 slipping add no stiffness) has no viscous damping (:math:`C \phi_r = 0`), then at a large
 modal amplitude :math:`a` the elements slip almost all the time and, per period at
 :math:`w_r`,
@@ -25,13 +25,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
-
-_LIMIT_OF = {
-    "Jenkins": lambda e: e.slip_force,
-    "CoulombRegularised": lambda e: float(e.params[0]),
-    "CoulombStickSlip": lambda e: float(e.params[1] * e.params[3]),
-}
-
 
 @dataclass(frozen=True)
 class UnboundedMode:
@@ -57,12 +50,9 @@ def unbounded_modes(model, elements, force: np.ndarray, force_sine: np.ndarray) 
     """The modes of ``model`` (a :class:`hbm.model.linear.LinearModel`) that the friction
     ``elements`` cannot bound under the force ``force cos + force_sine sin`` (n,) each;
     empty when the test does not apply (module doc)."""
-    limits = []
-    for e in elements:
-        get = _LIMIT_OF.get(type(e).__name__)
-        if get is None:
-            return []
-        limits.append(get(e))
+    limits = [e.slip_limit for e in elements]
+    if any(fs is None for fs in limits):
+        return []
     lam, phi = sla.eigh(model.K, model.M)
     F = np.asarray(force, dtype=float) - 1j * np.asarray(force_sine, dtype=float)
     out = []

@@ -156,8 +156,8 @@ def stiff_contact_hint(case: Case) -> str:
     K = case.model.K
     stiff = []
     for e in case.elements:
-        if type(e).__name__ != "Jenkins" or e.aft != "sampled":
-            continue
+        if getattr(e, "harmonic_forces", None) is None or e.aft != "sampled":
+            continue                # no event-based AFT to offer, or already on it
         g = e.gather[0]
         ks = float(g @ K @ g) / float(g @ g)
         if ks > 0 and e.kt >= STIFF_CONTACT * ks:

@@ -211,16 +211,14 @@ def trace_window(problem, case, window, xscale, r_scale, opts, progress, setting
         # the rest of the window lies on another branch, traced from fmax downwards
         first_msg = (f"the branch from {lo:.6g} Hz folded back to {pts.w[-1] / (2 * np.pi):.6g} Hz; "
                      f"traced the rest from {hi:.6g} Hz down")
-        part = _Path()
         try:
-            Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
+            part, (st2, msg2, f2, r2), _, folded = _down_from_fmax(problem, case, window, xscale, r_scale, opts,
+                                                                   progress, lam_step, offset=len(pts.w))
         except RuntimeError as exc:
             status, message = "failed", f"{first_msg}, but: {exc}"
         else:
-            st2, msg2, f2, r2 = _trace(problem, case, part, Xh, ith, w_hi, window, -1, xscale,
-                                       r_scale, opts, progress, offset=len(pts.w), lam_step=lam_step)
             folds, n_rej = folds + f2, n_rej + r2
-            if st2 == "finished" and part.w and part.w[-1] > w_lo * (1 + 1e-9):
+            if folded:
                 st2 = "failed"
                 msg2 = (f"the FRF between {part.w[-1] / (2 * np.pi):.6g} Hz and the first branch is not "
                         f"traced: the branch from {hi:.6g} Hz folded back too")
@@ -233,21 +231,36 @@ def trace_window(problem, case, window, xscale, r_scale, opts, progress, setting
     return pts, segments, (status, message, folds, n_rej), xscale
 
 
+def _down_from_fmax(problem, case, window, xscale, r_scale, opts, progress, lam_step, offset=0, widen=False):
+    """The branch through a first point at ``fmax``, traced down (points highest frequency
+    first); raises RuntimeError when that first point does not converge.
+
+    Returns ``(part, outcome, xscale, folded)``: the points, ``(status, message, folds_hz,
+    n_rejected)``, the scale (widened by the first point if ``widen``), and whether the
+    branch left the window again at ``fmax`` (folded back) instead of reaching ``fmin``."""
+    w_lo, w_hi = window
+    Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
+    if widen:
+        xscale = _widened_scale(problem, xscale, Xh)
+    part = _Path()
+    outcome = _trace(problem, case, part, Xh, ith, w_hi, window, -1, xscale, r_scale, opts, progress,
+                     offset=offset, lam_step=lam_step)
+    folded = outcome[0] == "finished" and bool(part.w) and part.w[-1] > w_lo * (1 + 1e-9)
+    return part, outcome, xscale, folded
+
+
 def _from_the_top(problem, case, window, xscale, r_scale, opts, progress, lam_step, why):
     """:func:`trace_window` when ``fmin``'s first point did not converge (``why``): the window
     from ``fmax`` down, the points returned lowest frequency first."""
-    w_lo, w_hi = window
-    hi = w_hi / (2 * np.pi)
-    pts, part = _Path(), _Path()
+    hi = window[1] / (2 * np.pi)
+    pts = _Path()
     try:
-        Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
+        part, (status, message, folds, n_rej), xscale, folded = _down_from_fmax(
+            problem, case, window, xscale, r_scale, opts, progress, lam_step, widen=True)
     except RuntimeError as exc:
         return pts, [], ("failed", f"{why}; from {hi:.6g} Hz neither: {exc}", [], 0), xscale
-    xscale = _widened_scale(problem, xscale, Xh)
-    status, message, folds, n_rej = _trace(problem, case, part, Xh, ith, w_hi, window, -1, xscale, r_scale,
-                                           opts, progress, lam_step=lam_step)
     pts.extend_reversed(part)
-    if status == "finished" and part.w and part.w[-1] > w_lo * (1 + 1e-9):
+    if folded:
         status, message = "failed", f"the branch from {hi:.6g} Hz folded back out of the window at {hi:.6g} Hz"
     elif len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
         status = "max_steps"

@@ -109,6 +109,11 @@ class NonlinearForces:
             return u
         return np.hstack([u, w * (self.basis.dE @ U)])
 
+    def _exact(self, e, U):
+        """``(F (nc, nl), dF (nc, nl, nc nl))`` of an element whose forces come from its events
+        (``aft = "events"``), or None: a sampled element, or a period it leaves to the march."""
+        return e.harmonic_forces(U, *self._kinds) if e.aft == "events" else None
+
     def evaluate(self, Xnl: np.ndarray, w: float, J_out: np.ndarray | None = None):
         """Forces and exact derivatives.
 
@@ -151,7 +156,7 @@ class NonlinearForces:
                 continue
             nl = e.n_local
             U = Xnl @ G.T
-            exact = e.harmonic_forces(U, *self._kinds) if e.aft == "events" else None
+            exact = self._exact(e, U)
             if exact is not None:
                 Fe, dU = exact
                 F += Fe @ G
@@ -192,7 +197,7 @@ class NonlinearForces:
                     unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F) < 0
                 continue
             e = self.elements[i]
-            exact = e.harmonic_forces(Xnl @ self._G[i].T, *self._kinds) if e.aft == "events" else None
+            exact = self._exact(e, Xnl @ self._G[i].T)
             if exact is not None:
                 F += exact[0] @ self._G[i]
                 continue
