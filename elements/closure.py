@@ -25,9 +25,10 @@ Rules (so that the physical transient from the rest state is kept where it decid
   the transverse force of a contact slipping along a line: the state is exactly periodic
   after one pass, its derivative is not), one Newton update of the seeds alone and a last
   pass give the derivative of the periodic solution rather than of a finite number of passes;
-- when ``I - M`` is singular (1-norm condition number > 1e12: a direction that never slips
-  keeps its start value, the rest-state convention) or a Newton step does not reduce the residual, plain
-  passes are used.
+- when ``I - M`` is singular (1-norm condition number > 1e12 in the state's own scales, so
+  that a force state beside a displacement state does not count as singular: a direction
+  that never slips keeps its start value, the rest-state convention) or a Newton step does
+  not reduce the residual, plain passes are used.
 
 The forces of the last pass, which starts from the closed state, are returned.
 """
@@ -123,17 +124,28 @@ def _close_or_update(s, s_begin, ds, ds_begin, Ms, tol, passes, last_res, newton
     # (I - M) Y = R: R = ds - ds_begin (state closed, seeds not: the affine seed map solved once,
     # then re-recorded), or R = [s - s_begin, ds - ds_begin] (Newton on state and seeds);
     # explicit loops, not array expressions: they cost seconds of compile time
+    # solved in the state's own scales, sigma_i = max(|s_i|, |s_begin_i|) (1 where both are 0):
+    # D^-1 (I - M) D (D^-1 Y) = D^-1 R, so that the condition number does not mix units (a
+    # force state beside a displacement state: kt = 1e6 N/m made I - M look singular, 1e14)
     o = 0 if state_closed else 1
+    sig = np.empty(ns)
+    for i in range(ns):
+        sig[i] = max(abs(s[i]), abs(s_begin[i]))
+        if sig[i] == 0.0:
+            sig[i] = 1.0
     K = np.empty((ns, ns))
     R = np.empty((ns, P + o))
     for i in range(ns):
         for k in range(ns):
-            K[i, k] = (1.0 if i == k else 0.0) - Ms[i, k]
+            K[i, k] = ((1.0 if i == k else 0.0) - Ms[i, k]) * sig[k] / sig[i]
         if o == 1:
-            R[i, 0] = s[i] - s_begin[i]
+            R[i, 0] = (s[i] - s_begin[i]) / sig[i]
         for c in range(P):
-            R[i, o + c] = ds[i, c] - ds_begin[i, c]
+            R[i, o + c] = (ds[i, c] - ds_begin[i, c]) / sig[i]
     Y, cond = _solve_small(K, R)
+    for i in range(ns):
+        for c in range(P + o):
+            Y[i, c] *= sig[i]
     if state_closed:
         if cond > 1e12:
             return True, last_res, newton_ok, seeds_fixed

@@ -281,3 +281,37 @@ def test_from_spec_keys_and_validation():
     for key, bad in (("kt", 0.0), ("kn", -1.0), ("mu", -0.1), ("normal_preload", -5.0)):
         with pytest.raises(ValueError, match=key):
             cls.from_spec({**spec, key: bad}, 6)
+
+
+# first-harmonic-dominated coefficients (units of 1e-5 m) of a contact of an FE patch
+# (benchmarks/contact_patch.py, 16 contacts): a thin ellipse in (t1, t2) that barely slips
+PATCH_U = np.array([[1.832e-04, 1.6556e-05, 0.0],
+                    [9.5797e-01, 2.1606e-02, -3.2649e-03],
+                    [8.0727e-01, 3.7429e-02, 2.6584e-05],
+                    [-2.5728e-04, 2.4512e-04, 2.036e-10],
+                    [-5.8976e-05, 5.4021e-05, 8.4831e-11],
+                    [-5.5929e-04, -1.9993e-05, -8.9913e-09],
+                    [-7.8120e-04, -2.5433e-05, -1.6894e-08]])
+
+
+@pytest.mark.parametrize("unit", [1e-5, 1.0])
+def test_newton_closure_does_not_mix_units(unit):
+    """The same loop in SI units (kt = 1.25e6 N/m, |u| ~ 1e-5 m) and in scaled units closes in
+    a few passes (the period map contracts by 0.99 per pass) and equals the loop closed by
+    plain passes.  The closure's condition number of ``I - M`` once mixed the force and
+    displacement states (1e14 in SI units): Newton was refused and 1000 plain passes did not
+    close the loop."""
+    from elements.law_march import march_of, CLOSE_PLAIN
+    el = make(2, kt=12.5 / unit, kn=25.0 / unit, mu=0.5, n0=31.25)
+    basis = FourierBasis(np.array([0, 1, 2, 3]), 128)
+    z = np.ascontiguousarray(basis.E @ (PATCH_U * unit))
+    dz = np.zeros(z.shape + (1,))
+    start = el.start_index(z[:, :el.n_local])
+    f, _, passes = march_newton(el.kind, el.params, el.n_state, el.n_local, z, dz, start, el.max_passes,
+                                el.closure_tol)
+    assert 0 < passes <= 12
+    f_plain, _, plain = march_of(el.kind, CLOSE_PLAIN)(el.params, el.n_state, el.n_local, z, dz, start,
+                                                      20000, 1e-14)
+    assert plain > 200                              # a slowly contracting loop indeed
+    np.testing.assert_allclose(f, f_plain, atol=1e-9 * 15.6)
+    assert el.summary(f, z)["slip_fraction"] > 0
