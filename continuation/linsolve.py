@@ -23,7 +23,7 @@ import warnings
 
 import numpy as np
 from scipy.linalg import LinAlgWarning, lu_factor, lu_solve
-from scipy.linalg.lapack import dgesv
+from scipy.linalg.lapack import dgesv, dgetrs
 
 REUSE_MIN_SIZE = 800      # below this a fresh LU is cheaper than a few Krylov iterations
 
@@ -111,16 +111,16 @@ class ReusedLU:
         g[0] = beta
         cs, sn = np.zeros(m), np.zeros(m)
         Zs = np.empty((m, b.size))
+        lu, piv = self._lu
         for k in range(m):
-            Zs[k] = lu_solve(self._lu, V[k], trans=self._trans, check_finite=False)
+            Zs[k] = dgetrs(lu, piv, V[k], trans=self._trans)[0]
             w = A @ Zs[k]
-            for i in range(k + 1):                   # modified Gram-Schmidt, twice
-                Hh[i, k] = V[i] @ w
-                w -= Hh[i, k] * V[i]
-            for i in range(k + 1):
-                c = V[i] @ w
-                Hh[i, k] += c
-                w -= c * V[i]
+            Vk = V[:k + 1]
+            h = Vk @ w                               # classical Gram-Schmidt, twice (CGS2):
+            w -= h @ Vk                              # as stable as modified Gram-Schmidt
+            c = Vk @ w                               # twice, in matrix-vector products
+            w -= c @ Vk
+            Hh[:k + 1, k] = h + c
             Hh[k + 1, k] = np.linalg.norm(w)
             if Hh[k + 1, k] > 0.0:
                 V[k + 1] = w / Hh[k + 1, k]
