@@ -157,8 +157,9 @@ class Arclength:
         self.points: list[ContinuationPoint] = []
         self._started = False
         self._rho0: float | None = None
-        # large systems keep an LU across Newton iterations and steps (continuation.linsolve)
-        self._linear_solve = ReusedLU() if x0.size >= REUSE_MIN_SIZE else direct_solve
+        # large systems keep an LU across Newton iterations and steps (continuation.linsolve);
+        # callers may solve their own (n+1, n+1) systems with it (a fixed-parameter polish)
+        self.linear_solve = ReusedLU() if x0.size >= REUSE_MIN_SIZE else direct_solve
 
     # ------------------------------------------------------------------ evaluation
     def _evaluate(self, xs: np.ndarray) -> Evaluation:
@@ -177,7 +178,7 @@ class Arclength:
         o = self.options
         with np.errstate(all="ignore"):
             return correct(self._evaluate, xs0, constraint, self._rho0, o.tol, o.max_iter,
-                           o.max_backtrack, linear_solve=self._linear_solve)
+                           o.max_backtrack, linear_solve=self.linear_solve)
 
     def _fixed_lam(self, xs0: np.ndarray, lam_s: float) -> Correction:
         e = np.zeros_like(xs0)
@@ -222,7 +223,7 @@ class Arclength:
             return
         e = np.zeros_like(xs)
         e[-1] = self.direction
-        t = null_tangent(c.ev.Js, e)
+        t = null_tangent(c.ev.Js, e, self.linear_solve)
         if t[-1] * self.direction < 0:
             t = -t
         yield self._point(c, t, 0.0, False, on_bound=xs[-1] in (lo_s, hi_s))
@@ -360,7 +361,7 @@ class Arclength:
         if fast:
             t_new = c.null * f
         else:
-            u = null_tangent(c.ev.Js, t)
+            u = null_tangent(c.ev.Js, t, self.linear_solve)
             _, _, _, cosang, f = step_geometry(xs, t, c.xs, start, u)
             t_new = u * f
         cosang = min(1.0, max(-1.0, cosang))

@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 
 from continuation import Arclength
-from continuation.linsolve import REUSE_MIN_SIZE, ReusedLU
 
 from hbm.analyses.problem_setup import _first_point, recover_outputs
 from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
@@ -26,26 +25,38 @@ POLISH_ENERGY = 1e-10
 # a point whose energy balance stays looser than this after polishing is not a solution
 # the FRF can report: the path ends before it (status failed, the point named)
 ENERGY_LIMIT = 1e-8
-def _polish(problem, X, w, xscale, r_scale, err, linear_solve=None):
+def _polish(problem, X, w, xscale, r_scale, err, linear_solve=None, w_scale=1.0):
     """Newton at fixed ``w`` on a point whose energy balance is not closed.
 
     The continuation's tolerance is relative to the Jacobian's row norm, which a stiff
     contact (kt >> k) makes large against the excitation: such a point can be accepted with
     ``|R| / |F|`` ~ 1e-9 and an energy error ~ 1e-6.  Here the target is relative to ``|F|``.
-    Returns the better of the two points and its relative energy error.  ``linear_solve``:
-    Newton's linear solver (:func:`hbm.balance.newton.newton`), one kept LU shared by a path's polishes.
+    Returns the better of the two points and its relative energy error.
+
+    The update solves the continuation's bordered system with the frequency row fixed,
+    ``[J, dR/dw; e_w^T] [dX; dw] = [-R; 0]`` (so ``dw = 0``), with ``linear_solve``: the
+    path's own solver (:attr:`continuation.arclength.Arclength.linear_solve`), whose kept LU
+    of ``[J, dR/dw; rho t^T]`` at the last point differs from it by one row, so that a
+    large polish costs a few Krylov iterations instead of a factorisation.  ``w_scale`` is
+    the path's scale of ``w`` (the same column scaling as the kept LU's).
     """
-    fun = lambda u: problem.residual(problem.expand(u), w)[:2]
-    res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, tol=1e-13, max_iter=4,
-                 linear_solve=linear_solve)
+    nu = problem.n_unknowns
+
+    def bordered(u):
+        Jb = np.empty((nu + 1, nu + 1))       # the residual writes its Jacobian in place
+        Jb[nu, :nu] = 0.0
+        Jb[nu, nu] = 1.0
+        R = problem.jacobian_into(problem.expand(u[:-1]), w, Jb[:nu])
+        return np.r_[R, 0.0], Jb
+
+    res = newton(bordered, np.r_[problem.unknowns(X), w], scale=np.r_[xscale, w_scale], r_scale=r_scale,
+                 tol=1e-13, max_iter=4, linear_solve=linear_solve, overwrite_jacobian=True)
     if np.all(np.isfinite(res.x)):
-        Xp = problem.expand(res.x)
+        Xp = problem.expand(res.x[:-1])
         err_p = energy_balance(problem, Xp, w).relative_error
         if err_p < err:
             return Xp, err_p
     return X, err
-
-
 
 
 class _Path:
@@ -95,13 +106,12 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
                        direction=direction, options=opts, lam_step=lam_step, overwrite_jacobian=True,
                        describe_lam=lambda lam: f"{lam / (2 * np.pi):.6g} Hz")
-    polish_solve = ReusedLU() if problem.n_unknowns >= REUSE_MIN_SIZE else None
     for pt in solver:
         X = problem.expand(pt.x[:-1])
         w = float(pt.x[-1])
         err = energy_balance(problem, X, w).relative_error
         if err > POLISH_ENERGY:
-            X, err = _polish(problem, X, w, xscale, r_scale, err, polish_solve)
+            X, err = _polish(problem, X, w, xscale, r_scale, err, solver.linear_solve, scale[-1])
         if err > ENERGY_LIMIT:
             return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
                     f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "

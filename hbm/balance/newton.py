@@ -36,17 +36,26 @@ class NewtonResult:
     message: str
 
 
-def _polished(x, R, J, S, linear_solve):
+def _scaled(J, S, overwrite):
+    """``J diag(S)``, in place when ``overwrite``."""
+    if overwrite:
+        J *= S
+        return J
+    return J * S
+
+
+def _polished(x, R, J, S, linear_solve, overwrite=False):
     """One more Newton update with the Jacobian at hand (no further evaluation): by quadratic
     convergence the point is then accurate to about the square of the accepted error, so that
     round-off (e.g. a BLAS's thread count) no longer shows in the answer."""
-    dy = linear_solve(J * S, -R[:, None])
+    dy = linear_solve(_scaled(J, S, overwrite), -R[:, None])
     if dy is None or not np.all(np.isfinite(dy)):
         return x
     return x + S * dy[:, 0]
 
 
-def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_solve=None) -> NewtonResult:
+def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_solve=None,
+           overwrite_jacobian=False) -> NewtonResult:
     """Solve ``fun(x) = (R, J) -> R = 0``.
 
     Parameters
@@ -67,6 +76,9 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
         pass one :class:`~continuation.linsolve.ReusedLU` to many calls to keep its LU);
         default: a direct LU, or a kept LU with GMRES for this call's iterations when
         ``n >= REUSE_MIN_SIZE``.
+    overwrite_jacobian : bool
+        ``fun`` returns a new ``J`` on every call, which may be scaled in place (no copy of an
+        ``n x n`` matrix per update).
 
     Returns
     -------
@@ -84,8 +96,8 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
         if not np.all(np.isfinite(R)):
             return NewtonResult(x, False, it - 1, np.inf, "residual is not finite")
         if r <= target:
-            return NewtonResult(_polished(x, R, J, S, linear_solve), True, it - 1, r, "converged")
-        dy = linear_solve(J * S, -R[:, None])
+            return NewtonResult(_polished(x, R, J, S, linear_solve, overwrite_jacobian), True, it - 1, r, "converged")
+        dy = linear_solve(_scaled(J, S, overwrite_jacobian), -R[:, None])
         if dy is None or not np.all(np.isfinite(dy)):
             return NewtonResult(x, False, it - 1, r, "singular Jacobian")
         dy = dy[:, 0]
@@ -101,6 +113,6 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
             alpha *= 0.5
         x, R, J, r = xt, Rt, Jt, rt
     if r <= target:
-        return NewtonResult(_polished(x, R, J, S, linear_solve), True, max_iter, r, "converged")
+        return NewtonResult(_polished(x, R, J, S, linear_solve, overwrite_jacobian), True, max_iter, r, "converged")
     return NewtonResult(x, False, max_iter, r,
                         f"no convergence in {max_iter} iterations (residual {r:.3g}, target {target:.3g})")

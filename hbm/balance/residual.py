@@ -101,16 +101,21 @@ class HarmonicBalance:
         """
         nu = self.n_unknowns
         A = np.empty((nu, nu + 1))         # the layout of __call__'s: one compiled variant of each kernel
-        R = self._evaluate(X, float(w), A[:, :nu], A[:, nu])
+        R = self.jacobian_into(X, w, A)
         return R, A[:, :nu], A[:, nu]
+
+    def jacobian_into(self, X: np.ndarray, w: float, out: np.ndarray) -> np.ndarray:
+        """``R`` (n_u,) returned; ``[dR/dX, dR/dw]`` written into ``out`` (n_u, n_u + 1), a
+        caller's array or a view of one (a bordered system's first rows: no copy of an
+        ``n_u x n_u`` matrix)."""
+        nu = self.n_unknowns
+        return self._evaluate(X, float(w), out[:, :nu], out[:, nu])
 
     def __call__(self, x: np.ndarray):
         """Continuation form: ``x = [unknowns, w]`` -> ``R`` (n_u,), ``[dR/dX, dR/dw]``
         (n_u, n_u + 1), new arrays on every call."""
-        nu = self.n_unknowns
-        A = np.empty((nu, nu + 1))
-        R = self._evaluate(self.expand(x[:-1]), float(x[-1]), A[:, :nu], A[:, nu])
-        return R, A
+        A = np.empty((self.n_unknowns, self.n_unknowns + 1))
+        return self.jacobian_into(self.expand(x[:-1]), x[-1], A), A
 
     def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray, dRw: np.ndarray) -> np.ndarray:
         """``R`` (n_u,) returned; ``dR/dX`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw``."""
