@@ -3,20 +3,10 @@ when the residual's work explains the energy imbalance, and returns the point af
 evaluation when it cannot (the imbalance is then not the residual's, so no update closes it)."""
 import numpy as np
 
-import hbm
 from hbm.analyses.problem_setup import solve_at
 from hbm.analyses.trace import _polish
 from hbm.balance.energy import EnergyBalance
-
-
-def three_dof():
-    K = np.array([[2.0, -1, 0], [-1, 2, -1], [0, -1, 1]])
-    return hbm.case_from_dict({
-        "model": {"mass": [1.0, 1.0, 1.0], "stiffness": K, "damping": 0.02 * K},
-        "element": [{"type": "jenkins", "dofs": [0], "kt": 20.0, "slip_force": 1.0},
-                    {"type": "jenkins", "dofs": [2], "kt": 20.0, "slip_force": 1.0}],
-        "excitation": {"dofs": [2], "amplitude": [1.0]},
-        "analysis": {"harmonics": 7, "time_samples": 128, "frequency_hz": [0.05, 0.35], "outputs": {"x3": 2}}})
+from test_truncation import three_dof
 
 
 def counted(problem):
