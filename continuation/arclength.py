@@ -223,7 +223,7 @@ class Arclength:
             return
         e = np.zeros_like(xs)
         e[-1] = self.direction
-        t = null_tangent(c.ev.Js, e, self.linear_solve)
+        t = null_tangent(c.ev.Js, e)
         if t[-1] * self.direction < 0:
             t = -t
         yield self._point(c, t, 0.0, False, on_bound=xs[-1] in (lo_s, hi_s))
@@ -361,7 +361,7 @@ class Arclength:
         if fast:
             t_new = c.null * f
         else:
-            u = null_tangent(c.ev.Js, t, self.linear_solve)
+            u = null_tangent(c.ev.Js, t)
             _, _, _, cosang, f = step_geometry(xs, t, c.xs, start, u)
             t_new = u * f
         cosang = min(1.0, max(-1.0, cosang))

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def null_tangent(Js: np.ndarray, t_ref: np.ndarray, linear_solve=None) -> np.ndarray:
+def null_tangent(Js: np.ndarray, t_ref: np.ndarray) -> np.ndarray:
     """Unit null vector of ``Js`` with a positive component along ``t_ref``.
 
     Parameters
@@ -37,10 +37,6 @@ def null_tangent(Js: np.ndarray, t_ref: np.ndarray, linear_solve=None) -> np.nda
         Scaled Jacobian ``dR/dxs``.
     t_ref : ndarray, shape (n+1,)
         Reference direction (unit), e.g. the previous tangent.
-    linear_solve : callable, optional
-        ``(A (n+1, n+1) C-ordered, B (n+1, 1)) -> A^{-1} B`` or None when singular, e.g. the
-        continuation's kept LU (:mod:`continuation.linsolve`), whose preconditioner is this
-        very system at a neighbouring point; default a fresh LU.
 
     Returns
     -------
@@ -50,16 +46,12 @@ def null_tangent(Js: np.ndarray, t_ref: np.ndarray, linear_solve=None) -> np.nda
     n = Js.shape[0]
     rho = max(float(np.abs(Js).sum(axis=1).max(initial=0.0)), 1e-300)
     A = np.vstack([Js, rho * t_ref[None, :]])
-    rhs = np.zeros((n + 1, 1))
+    rhs = np.zeros(n + 1)
     rhs[-1] = rho
-    if linear_solve is None:
-        try:
-            v = np.linalg.solve(A, rhs)
-        except np.linalg.LinAlgError:
-            v = None
-    else:
-        v = linear_solve(A, rhs)
-    v = None if v is None else v[:, 0]
+    try:
+        v = np.linalg.solve(A, rhs)
+    except np.linalg.LinAlgError:
+        v = None
     if v is None or not np.all(np.isfinite(v)) or not np.any(v):
         v = np.linalg.svd(Js)[2][-1]
     t = v / np.linalg.norm(v)
