@@ -43,8 +43,9 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
     ``[J, dR/dw; e_w^T] [dX; dw] = [-R; 0]`` (so ``dw = 0``), with ``linear_solve``: the
     path's own solver (:attr:`continuation.arclength.Arclength.linear_solve`), whose kept LU
     of ``[J, dR/dw; rho t^T]`` at the last point differs from it by one row, so that a
-    large polish costs a few Krylov iterations instead of a factorisation.  ``w_scale`` is
-    the path's scale of ``w`` (the same column scaling as the kept LU's).
+    large polish costs a few Krylov iterations instead of a factorisation (and a factorisation
+    it does make becomes the path's kept LU, one row away from the path's matrices).
+    ``w_scale`` is the path's scale of ``w`` (the same column scaling as the kept LU's).
     """
     nu = problem.n_unknowns
     err = eb.relative_error
@@ -61,7 +62,7 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
     explained = np.pi * abs(first[0][:-1] @ problem.unknowns(problem.basis.D @ X))
     if explained < 0.1 * abs(eb.excitation - eb.viscous - eb.nonlinear):
         return X, err
-    calls = iter([first])
+    calls = iter([first])                     # Newton's first call gets the evaluation at hand
     res = newton(lambda u: next(calls, None) or bordered(u), x0, scale=np.r_[xscale, w_scale],
                  r_scale=r_scale, tol=1e-13, max_iter=4, linear_solve=linear_solve, overwrite_jacobian=True)
     if np.all(np.isfinite(res.x)):
