@@ -52,9 +52,9 @@ from typing import Callable, Iterator
 
 import numpy as np
 
+from .acceptance import Step, judge_step
 from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
 from .linsolve import REUSE_MIN_SIZE, ReusedLU, direct_solve
-from .kernels import step_geometry
 from .options import ArclengthOptions, default_scale
 from .point import ContinuationPoint
 from .tangent import fold_parameter, null_tangent
@@ -246,18 +246,18 @@ class Arclength:
                 return
 
             ds = self._limited(xs, t, ds)
-            c, t_new, angle, reason, on_bound = self._step(xs, t, ds, angle_reject, False)
-            if reason is not None and consecutive >= 1 and not on_bound:
+            out = self._step(xs, t, ds, angle_reject, False)
+            if out.reason is not None and consecutive >= 1 and not out.on_bound:
                 # repeated trouble at this point: maybe a sharp corner of the path, which a
                 # hyperplane normal to t cannot cross; try a sphere around the last point
-                c2, t2, a2, r2, b2 = self._step(xs, t, ds, angle_reject, True)
-                if r2 is None or r2.startswith("the tangent turned"):
-                    c, t_new, angle, reason, on_bound = c2, t2, a2, r2, b2
-
+                out2 = self._step(xs, t, ds, angle_reject, True)
+                if out2.reason is None or out2.turned:
+                    out = out2
+            c, t_new, angle, reason, on_bound = out[:5]
             if reason is not None:
                 self.n_rejected += 1
                 consecutive += 1
-                if reason.startswith("the tangent turned"):
+                if out.turned:
                     angle_reject = (ds, angle)
                 # other reasons keep the memory of a turn: at a corner the hyperplane
                 # corrector fails (branch jump) at every ds, only the sphere sees the turn
@@ -313,18 +313,16 @@ class Arclength:
             return self.ds_min
         return max(min(ds, cap / (s_lam * abs(t[-1]))), self.ds_min)
 
-    def _step(self, xs, t, ds, angle_reject, sphere):
-        """Predict and correct one step; return ``(c, t_new, angle, reason, on_bound)``.
+    def _step(self, xs, t, ds, angle_reject, sphere) -> Step:
+        """Predict and correct one step (:mod:`continuation.acceptance` decides it).
 
-        ``reason`` is ``None`` when the step is acceptable.  ``sphere`` replaces the
-        hyperplane ``t @ (xs' - pred) = 0`` by the sphere ``|xs' - xs| = ds``, which may turn
-        by more than 90 degrees (a corner of the path); only a turn back onto the incoming
-        direction is refused then.
+        ``sphere`` replaces the hyperplane ``t @ (xs' - pred) = 0`` by the sphere
+        ``|xs' - xs| = ds``, which may turn by more than 90 degrees (a corner of the path);
+        only a turn back onto the incoming direction is refused then.
         """
         o = self.options
         s_lam = self.scale[-1]
         lo_s, hi_s = self.lam_bounds[0] / s_lam, self.lam_bounds[1] / s_lam
-        max_angle = math.radians(o.max_angle_deg)
         pred = xs + ds * t
         start = pred
         on_bound = False
@@ -337,51 +335,20 @@ class Arclength:
             con = sphere_constraint(xs, ds) if sphere else linear_constraint(t, float(t @ pred))
             c = self._correct(pred, con)
             if c.converged and not lo_s <= c.xs[-1] <= hi_s:
+                # the hyperplane may cut the path again far away (a scaled tangent made of
+                # amplitudes meets the same amplitudes at the other end of the window):
+                # leave the window only from a point found near the predictor, moving on
+                jump = _norm(c.xs - pred)
+                if jump > o.max_correction * ds or (c.xs[-1] - xs[-1]) * t[-1] < 0:
+                    return Step(c, None, 0.0, f"the corrector left the window {jump / ds:.2g} "
+                                f"step lengths from the predictor (branch jump)", False)
                 bound = hi_s if c.xs[-1] > hi_s else lo_s
-                new = c.xs
-                start = xs + ((bound - xs[-1]) / (new[-1] - xs[-1])) * (new - xs)
+                start = xs + ((bound - xs[-1]) / (c.xs[-1] - xs[-1])) * (c.xs - xs)
                 c = self._fixed_lam(start, bound)
                 on_bound = True
         if not c.converged:
-            return c, None, 0.0, f"Newton did not converge ({c.reason})", on_bound
-        # the hyperplane's a is t: the corrector's null vector solves the tangent system
-        # (finite, and t @ null = 1, so not zero)
-        fast = c.null is not None and not sphere and not on_bound
-        chord_len, along, jump, cosang, f = step_geometry(xs, t, c.xs, start, c.null if fast else t)
-        if not chord_len > 0:
-            return c, None, 0.0, "the corrector returned to the last point", on_bound
-        if sphere:
-            if along <= -math.cos(max_angle) * chord_len:
-                return c, None, 0.0, "the corrector went back along the path", on_bound
-        elif along <= 0:
-            return c, None, 0.0, "the corrector went back along the path", on_bound
-        if not sphere and not on_bound and jump > o.max_correction * ds:
-            return (c, None, 0.0,
-                    f"the corrector moved {jump / ds:.2g} step lengths (branch jump)", on_bound)
-        if fast:
-            t_new = c.null * f
-        else:
-            u = null_tangent(c.ev.Js, t)
-            _, _, _, cosang, f = step_geometry(xs, t, c.xs, start, u)
-            t_new = u * f
-        cosang = min(1.0, max(-1.0, cosang))
-        dlam = c.xs[-1] - xs[-1]
-        if (not on_bound and t[-1] * t_new[-1] > 0 and dlam * t[-1] < 0
-                and abs(dlam) > 1e-3 * ds * abs(t[-1])):
-            # the parameter moved against both end tangents: no fold can lie between, so the
-            # corrector landed on another part of the path (one that passes close by, e.g.
-            # the start of a resonance loop seen from its end)
-            return c, None, 0.0, "the parameter went back without a fold (branch jump)", on_bound
-        angle = math.acos(cosang)
-        if cosang <= (-math.cos(max_angle) if sphere else 0.0):
-            return c, t_new, angle, "the tangent reversed", on_bound
-        if angle > max_angle:
-            kink = (angle_reject is not None and angle_reject[0] > ds
-                    and angle > 0.7 * angle_reject[1])
-            if not kink and 0.5 * ds >= self.ds_min:
-                return (c, t_new, angle, f"the tangent turned {math.degrees(angle):.1f} deg "
-                        f"> max_angle_deg={o.max_angle_deg:g}", on_bound)
-        return c, t_new, angle, None, on_bound
+            return Step(c, None, 0.0, f"Newton did not converge ({c.reason})", on_bound)
+        return judge_step(c, xs, t, start, ds, sphere, on_bound, o, angle_reject, self.ds_min)
 
     def _fail(self, message: str) -> None:
         self.status = "failed"
