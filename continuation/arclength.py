@@ -98,6 +98,11 @@ class Arclength:
     overwrite_jacobian : bool
         ``fun`` returns a new ``J`` on every call, which the solver may scale in place (saves
         one ``n x (n+1)`` array per evaluation on large systems).
+    fun_into : callable, optional
+        ``fun_into(x, out) -> R``: ``fun`` writing ``J`` into ``out`` (n, n+1), a C-ordered
+        view of the rows of a Newton matrix.  Large systems then keep the Jacobian inside
+        the corrector's Newton matrix (:func:`continuation.corrector.correct`): with the kept
+        LU, two ``n x n`` arrays in all while a step is corrected.
     describe_lam : callable, optional
         ``lam -> str`` naming a parameter value in messages (default ``"lam=<value>"``).
 
@@ -122,7 +127,7 @@ class Arclength:
 
     def __init__(self, fun: Fun, x0, scale=None, lam_bounds=(-np.inf, np.inf),
                  direction: int = +1, options: ArclengthOptions | None = None, lam_step=None,
-                 overwrite_jacobian: bool = False, describe_lam=None):
+                 overwrite_jacobian: bool = False, describe_lam=None, fun_into=None):
         x0 = np.array(x0, dtype=float).ravel()
         if x0.size < 2 or not np.all(np.isfinite(x0)):
             raise ValueError("x0 must be a finite vector [y, lam] with at least one unknown")
@@ -139,6 +144,7 @@ class Arclength:
         if scale.shape != x0.shape or not np.all(np.isfinite(scale)) or np.any(scale <= 0):
             raise ValueError(f"scale must be {x0.size} positive finite numbers")
         self.fun = fun
+        self.fun_into = fun_into
         self.x0 = x0
         self.scale = scale
         self.lam_bounds = (lo, hi)
@@ -174,11 +180,20 @@ class Arclength:
                              f"got {R.shape} and {J.shape}")
         return Evaluation.scaled(xs.copy(), R, J, self.scale, out=J if self._overwrite else None)
 
+    def _evaluate_into(self, xs: np.ndarray, out: np.ndarray) -> Evaluation:
+        """One call of ``fun_into``, ``J`` written and scaled in ``out`` (n, n+1)."""
+        self.n_eval += 1
+        R = np.ascontiguousarray(self.fun_into(xs * self.scale, out), dtype=float).reshape(-1)
+        if R.shape != (out.shape[0],):
+            raise ValueError(f"fun_into must return R shape ({out.shape[0]},), got {R.shape}")
+        return Evaluation.scaled(xs.copy(), R, out, self.scale, out=out)
+
     def _correct(self, xs0, constraint) -> Correction:
         o = self.options
+        into = self._evaluate_into if self.fun_into is not None else None
         with np.errstate(all="ignore"):
             return correct(self._evaluate, xs0, constraint, self._rho0, o.tol, o.max_iter,
-                           o.max_backtrack, linear_solve=self.linear_solve)
+                           o.max_backtrack, linear_solve=self.linear_solve, evaluate_into=into)
 
     def _fixed_lam(self, xs0: np.ndarray, lam_s: float) -> Correction:
         e = np.zeros_like(xs0)
@@ -223,7 +238,11 @@ class Arclength:
             return
         e = np.zeros_like(xs)
         e[-1] = self.direction
-        t = null_tangent(c.ev.Js, e)
+        t = null_tangent(c.ev.Js, e, c.matrix)
+        if t is None:
+            self._fail(f"the path's tangent at the starting point {self._lam(self.x0[-1])} is "
+                       f"undefined (singular bordered system)")
+            return
         if t[-1] * self.direction < 0:
             t = -t
         yield self._point(c, t, 0.0, False, on_bound=xs[-1] in (lo_s, hi_s))
@@ -246,6 +265,7 @@ class Arclength:
                 return
 
             ds = self._limited(xs, t, ds)
+            c = out = out2 = None      # the last step's Jacobians are not needed any more
             out = self._step(xs, t, ds, angle_reject, False)
             if out.reason is not None and consecutive >= 1 and not out.on_bound:
                 # repeated trouble at this point: maybe a sharp corner of the path, which a

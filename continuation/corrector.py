@@ -52,7 +52,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from .kernels import bordered_system, inf_norm, scale_jacobian
+from .kernels import border_rows, bordered_system, inf_norm, scale_jacobian
 from .linsolve import direct_solve
 
 _EPS = np.finfo(float).eps
@@ -140,6 +140,10 @@ class Correction:
         ``ev`` (``a`` the constraint gradient there), a null vector of ``Js`` normalised by
         ``a @ v = 1``; for the arclength hyperplane (``a`` = the previous tangent) this is
         the new tangent's direction (:func:`continuation.tangent.null_tangent`'s system).
+    matrix : ndarray, shape (n+1, n+1), or None
+        The C-ordered Newton matrix whose first ``n`` rows are ``ev.Js`` (the Jacobian was
+        evaluated into it), a work array for one more bordered solve at ``ev``
+        (:func:`continuation.tangent.null_tangent`); ``None`` when ``ev.Js`` is its own array.
     """
 
     converged: bool
@@ -149,6 +153,7 @@ class Correction:
     reason: str = ""
     xs: np.ndarray | None = None
     null: np.ndarray | None = None
+    matrix: np.ndarray | None = None
 
     def __post_init__(self):
         if self.xs is None:
@@ -174,7 +179,8 @@ def sphere_constraint(center: np.ndarray, radius: float) -> Constraint:
 
 def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             constraint: Constraint, rho0: float | None, tol: float, max_iter: int, max_backtrack: int,
-            stall_factor: float = 10.0, stall_window: int = 3, linear_solve=direct_solve) -> Correction:
+            stall_factor: float = 10.0, stall_window: int = 3, linear_solve=direct_solve,
+            evaluate_into=None) -> Correction:
     """Newton with backtracking on ``[R(s*xs); g(xs)] = 0`` (module doc).
 
     Parameters
@@ -206,20 +212,22 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         ``(A (n+1, n+1), B (n+1, k)) -> A^{-1} B`` or None when singular; ``A`` is laid out in
         the solver's ``order`` attribute (default ``"F"``) and may be overwritten
         (:mod:`continuation.linsolve`: direct LU or a kept LU with GMRES).
+    evaluate_into : callable, optional
+        ``(xs, out (n, n+1)) -> Evaluation`` with ``Js`` written in ``out``; used when
+        ``linear_solve`` wants C order (and leaves ``A`` intact), so that the Jacobian lives
+        in the Newton matrix (:class:`_NewtonMatrices`).
 
     Returns
     -------
     Correction
     """
-    ev = evaluate(xs0)
+    mats = _NewtonMatrices(evaluate, evaluate_into, xs0.size, getattr(linear_solve, "order", "F"))
+    ev = mats.evaluate(xs0)
     if not ev.finite:
         return Correction(False, ev, 0, np.inf, "residual is not finite at the predictor")
     if rho0 is None:
         rho0 = 1e-300
-    n = ev.R.size
-    order = getattr(linear_solve, "order", "F")
-    A = np.empty((n + 1, n + 1), order=order)   # refilled before every solve
-    B2 = np.empty((n + 1, 2), order="F")
+    B2 = np.empty((xs0.size, 2), order="F")
     best = (np.inf, ev, 0)
     sqrt_tol = math.sqrt(tol)
     backtrack_below = max(1e3 * tol, sqrt_tol)
@@ -243,12 +251,11 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         # when converged, the same matrix also gives the null vector of Js (the tangent,
         # module doc) from a second right-hand side
         # (both right-hand sides are always written: one layout of B, one compiled kernel)
-        bordered_system(ev.Js, ev.R, a, rho, g, A, B2)
-        sol = linear_solve(A, B2 if converged else B2[:, :1])
+        sol = linear_solve(mats.matrix(ev, a, rho, g, B2), B2 if converged else B2[:, :1])
         d_max = math.nan if sol is None else inf_norm(sol[:, 0])
         if not math.isfinite(d_max):
             if converged:
-                return Correction(True, ev, it, res)
+                return Correction(True, ev, it, res, matrix=mats.holding(ev))
             return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
         delta = sol[:, 0]
         if converged:
@@ -256,28 +263,17 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
             if not math.isfinite(inf_norm(null)):
                 null = None
             # free polishing update: error ~ |delta|^2, no further call of the function
-            return Correction(True, ev, it, res, xs=ev.xs + delta, null=null)
+            return Correction(True, ev, it, res, xs=ev.xs + delta, null=null, matrix=mats.holding(ev))
         if res <= sqrt_tol and d_max <= 16 * _EPS * size:
-            return Correction(True, ev, it, res)
-        merit = max(res, abs(g))
-        theta = 1.0
+            return Correction(True, ev, it, res, matrix=mats.holding(ev))
         # near the solution (merit below sqrt(tol)) a full step is taken whatever it gives:
         # there the merit grows only when a stick-slip switch moves between samples, which a
         # shorter step does not cure (it would cost up to max_backtrack more evaluations)
-        for _ in range(max_backtrack + 1):
-            trial = evaluate(ev.xs + theta * delta)
-            if trial.finite:
-                rho_t = max(rho0, trial.row_norm())
-                merit_t = max(trial.r_max / rho_t,
-                              abs(constraint(trial.xs)[0]))
-                if merit_t < merit or merit <= backtrack_below:
-                    break
-            theta *= 0.5
-        else:
-            if not trial.finite:
-                return Correction(False, ev, it + 1, res,
-                                  f"residual not finite along the Newton update (residual {res:.1e})")
-            # no decrease even for a short step: take it anyway, the iteration limit decides
+        trial = _line_search(mats, constraint, ev.xs, delta, max(res, abs(g)), rho0, max_backtrack,
+                             backtrack_below)
+        if not trial.finite:
+            return Correction(False, ev, it + 1, res,
+                              f"residual not finite along the Newton update (residual {res:.1e})")
         ev = trial
     rho = max(rho0, ev.row_norm())
     res = ev.r_max / rho
@@ -287,6 +283,67 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         return Correction(False, ev, it, res, f"Newton stalled after {it} iterations "
                           f"(residual {res:.1e}, best {min(history):.1e})")
     if best[0] <= stall_factor * tol:
-        return Correction(True, best[1], best[2], best[0])
+        ev = mats.fresh(best[1])
+        return Correction(True, ev, best[2], best[0], matrix=mats.holding(ev))
     return Correction(False, ev, max_iter, res,
                       f"no convergence in {max_iter} iterations (residual {res:.1e})")
+
+
+def _line_search(mats, constraint, xs, delta, merit, rho0, max_backtrack, backtrack_below):
+    """The evaluation at ``xs + theta delta``, ``theta = 1, 1/2, ...`` until the merit falls
+    below ``merit`` (any ``theta = 1`` when ``merit <= backtrack_below``); the last trial
+    when none does (not finite only if every trial was)."""
+    theta = 1.0
+    for _ in range(max_backtrack + 1):
+        trial = mats.evaluate(xs + theta * delta)
+        if trial.finite:
+            merit_t = max(trial.r_max / max(rho0, trial.row_norm()), abs(constraint(trial.xs)[0]))
+            if merit_t < merit or merit <= backtrack_below:
+                return trial
+        theta *= 0.5
+    return trial
+
+
+class _NewtonMatrices:
+    """The corrector's Newton matrix (n+1, n+1) and where its evaluations keep ``Js``.
+
+    Without ``evaluate_into`` (or for a solver that wants Fortran order and overwrites the
+    matrix) the matrix is refilled from each evaluation's own ``Js``.  With it, every
+    evaluation writes ``Js`` into the matrix's first ``n`` rows, so the Newton matrix needs
+    only its constraint row and a large system holds one ``n x n`` array (plus the solver's
+    kept LU) however many evaluations the corrector makes.  The current iterate's ``Js`` is
+    needed only up to its solve: a trial point overwrites it, and becomes the current iterate
+    (a correction that fails on a non-finite trial returns an iterate whose ``Js`` is gone).
+    """
+
+    def __init__(self, evaluate, evaluate_into, n1: int, order: str):
+        self._evaluate = evaluate
+        self._into = evaluate_into if order == "C" else None
+        self._A = np.empty((n1, n1), order=order)
+        self._last = None
+
+    def evaluate(self, xs: np.ndarray) -> Evaluation:
+        """The function at ``xs`` (the first point or a trial)."""
+        if self._into is None:
+            return self._evaluate(xs)
+        self._last = self._into(xs, self._A[:-1])
+        return self._last
+
+    def matrix(self, ev: Evaluation, a, rho: float, g: float, B: np.ndarray) -> np.ndarray:
+        """The Newton matrix of the current iterate ``ev``; right-hand sides written in ``B``."""
+        if self._into is None:
+            bordered_system(ev.Js, ev.R, a, rho, g, self._A, B)
+        else:
+            border_rows(ev.R, a, rho, g, self._A, B)
+        return self._A
+
+    def holding(self, ev: Evaluation) -> np.ndarray | None:
+        """The Newton matrix if its first rows are ``ev.Js``, else None."""
+        return self._A if self._into is not None and ev is self._last else None
+
+    def fresh(self, ev: Evaluation) -> Evaluation:
+        """``ev`` (an earlier iterate) with its ``Js`` as evaluated: re-evaluated when a later
+        evaluation has overwritten it."""
+        if self._into is None or ev is self._last:
+            return ev
+        return self.evaluate(ev.xs)

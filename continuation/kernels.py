@@ -74,11 +74,19 @@ def bordered_system(Js, R, a, rho, g, A, B):
     """Fill the Newton matrix ``A`` (n+1, n+1) and right-hand sides ``B`` (n+1, k), k = 1 or 2
     (the second column gives the null vector of ``Js``; module doc)."""
     n, m = Js.shape
-    k = B.shape[1]
     for i in range(n):                  # row by row: Js is C-ordered (A is either)
         for j in range(m):
             A[i, j] = Js[i, j]
-    for j in range(m):
+    border_rows(R, a, rho, g, A, B)
+
+
+@nb.njit(cache=True)
+def border_rows(R, a, rho, g, A, B):
+    """The constraint row of ``A`` (n+1, n+1) (whose first ``n`` rows already hold ``Js``) and
+    the right-hand sides ``B`` (n+1, k) of :func:`bordered_system`."""
+    n = R.size
+    k = B.shape[1]
+    for j in range(n + 1):
         A[n, j] = rho * a[j]
     for i in range(n):
         B[i, 0] = -R[i]
@@ -87,6 +95,19 @@ def bordered_system(Js, R, a, rho, g, A, B):
         for i in range(n):
             B[i, 1] = 0.0
         B[n, 1] = rho
+
+
+@nb.njit(cache=True)
+def row_sum_norm(A):
+    """``||A||_inf`` (largest absolute row sum) of a 2-D array, without a temporary."""
+    norm = 0.0
+    for i in range(A.shape[0]):
+        s = 0.0
+        for j in range(A.shape[1]):
+            s += abs(A[i, j])
+        if s > norm:
+            norm = s
+    return norm
 
 
 @nb.njit(cache=True)

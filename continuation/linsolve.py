@@ -84,6 +84,7 @@ class ReusedLU:
 
     def _factor(self, A, B):
         trans = 1 if A.flags.c_contiguous and not A.flags.f_contiguous else 0
+        self._lu = None                      # not held while the next one is made
         try:
             with warnings.catch_warnings():      # a singular matrix is answered by None
                 warnings.simplefilter("ignore", LinAlgWarning)

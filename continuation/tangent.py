@@ -26,9 +26,12 @@ and the fold is :math:`p(\tau^*)` with :math:`p'(\tau^*) = 0`, :math:`\tau^* \in
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
+
+from .kernels import row_sum_norm
 
 
-def null_tangent(Js: np.ndarray, t_ref: np.ndarray) -> np.ndarray:
+def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = None) -> np.ndarray:
     """Unit null vector of ``Js`` with a positive component along ``t_ref``.
 
     Parameters
@@ -37,22 +40,37 @@ def null_tangent(Js: np.ndarray, t_ref: np.ndarray) -> np.ndarray:
         Scaled Jacobian ``dR/dxs``.
     t_ref : ndarray, shape (n+1,)
         Reference direction (unit), e.g. the previous tangent.
+    work : ndarray, shape (n+1, n+1), optional
+        C-ordered array whose first ``n`` rows are ``Js`` (the corrector's Newton matrix,
+        :attr:`continuation.corrector.Correction.matrix`): the bordered system is built and
+        factored in it, so ``Js`` is consumed and no ``(n+1)^2`` array is allocated.
 
     Returns
     -------
-    t : ndarray, shape (n+1,)
-        Unit tangent with ``t @ t_ref >= 0``; NaN-free whenever ``Js`` is finite.
+    t : ndarray, shape (n+1,), or None
+        Unit tangent with ``t @ t_ref >= 0``; NaN-free whenever ``Js`` is finite.  With
+        ``work``, None when the bordered system is singular (without it the last right singular
+        vector of ``Js`` is returned then).
     """
     n = Js.shape[0]
-    rho = max(float(np.abs(Js).sum(axis=1).max(initial=0.0)), 1e-300)
-    A = np.vstack([Js, rho * t_ref[None, :]])
+    rho = max(row_sum_norm(Js), 1e-300)
     rhs = np.zeros(n + 1)
     rhs[-1] = rho
-    try:
-        v = np.linalg.solve(A, rhs)
-    except np.linalg.LinAlgError:
-        v = None
+    if work is not None:
+        work[n] = rho * t_ref
+        lu, piv, info = dgetrf(work.T, overwrite_a=True)     # work.T is Fortran-ordered
+        v = dgetrs(lu, piv, rhs, trans=1)[0] if info == 0 else None
+        del lu
+    else:
+        A = np.empty((n + 1, n + 1), order="F")     # factored in place: one (n+1)^2 array
+        A[:n] = Js
+        A[n] = rho * t_ref
+        _, _, v, info = dgesv(A, rhs, overwrite_a=True, overwrite_b=False)
+        del A
+        v = v if info == 0 else None
     if v is None or not np.all(np.isfinite(v)) or not np.any(v):
+        if work is not None:
+            return None         # Js is consumed: the caller decides (a shorter step)
         v = np.linalg.svd(Js)[2][-1]
     t = v / np.linalg.norm(v)
     return -t if t @ t_ref < 0 else t

@@ -192,7 +192,7 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
     guesses = [problem.linear_solution(w0, problem.stuck_stiffness()), problem.linear_solution(w0)]
     last = None
     for g in guesses:
-        res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale)
+        res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale, overwrite_jacobian=True)
         if res.converged:
             return problem.expand(res.x), res.iterations
         last = res
@@ -203,7 +203,7 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
         def fun_l(x, lam=lam):
             R, J = fun(x)
             return R - (1.0 - lam) * R0, J
-        res = newton(fun_l, x, scale=scale, r_scale=r_scale, max_iter=60)
+        res = newton(fun_l, x, scale=scale, r_scale=r_scale, max_iter=60, overwrite_jacobian=True)
         its += res.iterations
         if not res.converged:
             break

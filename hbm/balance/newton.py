@@ -103,6 +103,7 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
         dy = dy[:, 0]
         if r <= floor_ok and np.max(np.abs(dy)) <= 16 * _EPS * (1.0 + np.max(np.abs(x / S))):
             return NewtonResult(x + S * dy, True, it - 1, r, "converged (residual at its round-off floor)")
+        J = None                # not needed past its solve: one n x n array less held
         alpha = 1.0
         while True:
             xt = x + alpha * S * dy

@@ -117,6 +117,11 @@ class HarmonicBalance:
         A = np.empty((self.n_unknowns, self.n_unknowns + 1))
         return self.jacobian_into(self.expand(x[:-1]), x[-1], A), A
 
+    def call_into(self, x: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """:meth:`__call__` with ``[dR/dX, dR/dw]`` written into ``out`` (n_u, n_u + 1), e.g.
+        the rows of the continuation's Newton matrix; returns ``R`` (n_u,)."""
+        return self.jacobian_into(self.expand(x[:-1]), x[-1], out)
+
     def _evaluate(self, X: np.ndarray, w: float, J: np.ndarray, dRw: np.ndarray) -> np.ndarray:
         """``R`` (n_u,) returned; ``dR/dX`` written into ``J`` (n_u, n_u), ``dR/dw`` into ``dRw``."""
         nl = self.nl
