@@ -227,28 +227,12 @@ class Arclength:
         o = self.options
         s_lam = self.scale[-1]
         lo_s, hi_s = self.lam_bounds[0] / s_lam, self.lam_bounds[1] / s_lam
-        xs = self.x0 / self.scale
-
-        # --- starting point, parameter fixed; its Jacobian row norm becomes rho0
-        self._rho0 = None
-        c = self._fixed_lam(xs, xs[-1])
-        self._rho0 = c.ev.row_norm() or 1.0
-        if not c.converged:
-            self._fail(f"starting point not solved at {self._lam(self.x0[-1])}: {c.reason}")
+        c, t = self._start(self.x0 / self.scale)
+        if c is None:
             return
-        e = np.zeros_like(xs)
-        e[-1] = self.direction
-        t = null_tangent(c.ev.Js, e, c.matrix)
-        if t is None:
-            self._fail(f"the path's tangent at the starting point {self._lam(self.x0[-1])} is "
-                       f"undefined (singular bordered system)")
-            return
-        if t[-1] * self.direction < 0:
-            t = -t
-        yield self._point(c, t, 0.0, False, on_bound=xs[-1] in (lo_s, hi_s))
+        yield self._point(c, t, 0.0, False, on_bound=c.xs[-1] in (lo_s, hi_s))
         xs = c.xs
         lam_prev_sign = _sign(t[-1])
-
         ds = self.ds0
         steps = 0
         consecutive = 0
@@ -263,16 +247,9 @@ class Arclength:
                 self.status = "finished"
                 self.message = f"parameter reached the bound {self._lam(xs[-1] * s_lam)}"
                 return
-
             ds = self._limited(xs, t, ds)
-            c = out = out2 = None      # the last step's Jacobians are not needed any more
-            out = self._step(xs, t, ds, angle_reject, False)
-            if out.reason is not None and consecutive >= 1 and not out.on_bound:
-                # repeated trouble at this point: maybe a sharp corner of the path, which a
-                # hyperplane normal to t cannot cross; try a sphere around the last point
-                out2 = self._step(xs, t, ds, angle_reject, True)
-                if out2.reason is None or out2.turned:
-                    out = out2
+            c = out = None      # the last step's Jacobians are not needed any more
+            out = self._attempt(xs, t, ds, angle_reject, consecutive)
             c, t_new, angle, reason, on_bound = out[:5]
             if reason is not None:
                 self.n_rejected += 1
@@ -288,17 +265,14 @@ class Arclength:
                                f"{reason}")
                     return
                 continue
-
             # --- accept
             steps += 1
             sign_new = _sign(t_new[-1])
             fold = lam_prev_sign != 0 and sign_new != 0 and sign_new != lam_prev_sign
             if fold:
-                h = _norm(c.xs - xs)
-                lam_f = fold_parameter(xs[-1], c.xs[-1], t[-1], t_new[-1], h)
+                lam_f = fold_parameter(xs[-1], c.xs[-1], t[-1], t_new[-1], _norm(c.xs - xs))
                 self.folds.append(float(lam_f * s_lam))
-            if sign_new != 0:
-                lam_prev_sign = sign_new
+            lam_prev_sign = sign_new or lam_prev_sign
             yield self._point(c, t_new, ds, fold, on_bound=on_bound)
             if on_bound:
                 self.status = "finished"
@@ -306,21 +280,56 @@ class Arclength:
                                 f"{self._lam(c.xs[-1] * s_lam)} after {steps} steps, "
                                 f"{len(self.folds)} folds, {self.n_rejected} rejections")
                 return
-            xs = c.xs
-            t = t_new
-            factor = math.sqrt(o.target_iter / max(c.iterations, 1))
-            factor = min(max(factor, o.shrink_min), o.grow_max)
-            if angle > 0:
-                factor = min(factor, max(o.shrink_min, 0.8 * math.radians(o.max_angle_deg) / angle))
-            if consecutive:
-                factor = min(factor, 1.0)
+            xs, t = c.xs, t_new
             # a step shorter than the last rejected turn approaches a corner: keep the
             # memory, so that the same turn at a smaller ds is recognised as a kink
             # (otherwise the path creeps towards the corner in ever shorter steps)
             if angle_reject is not None and not ds < angle_reject[0]:
                 angle_reject = None
-            ds = min(max(ds * factor, self.ds_min), self.ds_max)
+            ds = self._next_ds(ds, c.iterations, angle, consecutive)
             consecutive = 0
+
+    def _start(self, xs):
+        """The starting point, solved with the parameter fixed (its Jacobian's row norm becomes
+        ``rho0``), and its tangent along ``direction``: ``(c, t)``, or ``(None, None)`` after
+        :meth:`_fail`."""
+        self._rho0 = None
+        c = self._fixed_lam(xs, xs[-1])
+        self._rho0 = c.ev.row_norm() or 1.0
+        if not c.converged:
+            self._fail(f"starting point not solved at {self._lam(self.x0[-1])}: {c.reason}")
+            return None, None
+        e = np.zeros_like(xs)
+        e[-1] = self.direction
+        t = null_tangent(c.ev.Js, e, c.matrix)
+        if t is None:
+            self._fail(f"the path's tangent at the starting point {self._lam(self.x0[-1])} is "
+                       f"undefined (singular bordered system)")
+            return None, None
+        return c, (-t if t[-1] * self.direction < 0 else t)
+
+    def _attempt(self, xs, t, ds, angle_reject, consecutive) -> Step:
+        """One step on the hyperplane; after a rejection at this point, also on the sphere."""
+        out = self._step(xs, t, ds, angle_reject, False)
+        if out.reason is not None and consecutive >= 1 and not out.on_bound:
+            # repeated trouble at this point: maybe a sharp corner of the path, which a
+            # hyperplane normal to t cannot cross; try a sphere around the last point
+            out2 = self._step(xs, t, ds, angle_reject, True)
+            if out2.reason is None or out2.turned:
+                return out2
+        return out
+
+    def _next_ds(self, ds: float, iterations: int, angle: float, consecutive: int) -> float:
+        """The step after an accepted one (:mod:`continuation.options`): Newton's iterations
+        against ``target_iter``, the turn against ``max_angle_deg``, no growth right after a
+        rejection."""
+        o = self.options
+        factor = min(max(math.sqrt(o.target_iter / max(iterations, 1)), o.shrink_min), o.grow_max)
+        if angle > 0:
+            factor = min(factor, max(o.shrink_min, 0.8 * math.radians(o.max_angle_deg) / angle))
+        if consecutive:
+            factor = min(factor, 1.0)
+        return min(max(ds * factor, self.ds_min), self.ds_max)
 
     def _limited(self, xs, t, ds):
         """``ds`` shortened so that the predictor moves the parameter by at most

@@ -190,32 +190,21 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
     xs0 : ndarray, shape (n+1,)
         Scaled starting guess (the predictor).
     constraint : callable
-        ``xs -> (g, dg/dxs)``, e.g. :func:`linear_constraint` (arclength hyperplane, fixed
-        parameter) or :func:`sphere_constraint` (used to turn sharp corners of the path).
+        ``xs -> (g, dg/dxs)``: :func:`linear_constraint` or :func:`sphere_constraint`.
     rho0 : float or None
-        Lower bound of the residual scale (> 0); ``None``: no bound, the scale is the current ``||Js||_inf``.
-    tol : float
-        Tolerance on the scaled residual.
-    max_iter : int
-        Newton updates allowed.
-    max_backtrack : int
-        Halvings of an update tried when the merit grows.
-    stall_factor : float
-        Without convergence, the best iterate is accepted if its residual is within
-        ``stall_factor * tol`` and it satisfies the constraint (cycling at a kink).
-    stall_window : int
-        Newton gives up early when the last ``stall_window`` iterates have not halved the
-        smallest merit of the iterates before them (at least ``2 stall_window`` iterates
-        seen; 0: never): cycling at a stick-slip kink, which a shorter step resolves
-        sooner than further iterations at this one.
+        Lower bound of the residual scale; ``None``: the current ``||Js||_inf`` alone.
+    tol, max_iter, max_backtrack :
+        Tolerance on the scaled residual; Newton updates; halvings of an update.
+    stall_factor, stall_window :
+        Unconverged, the best iterate is accepted within ``stall_factor * tol``; Newton stops
+        early (stalled) when the last ``stall_window`` iterates have not halved the smallest
+        merit before them (0: never): cycling at a stick-slip kink, which a shorter step cures.
     linear_solve : callable
-        ``(A (n+1, n+1), B (n+1, k)) -> A^{-1} B`` or None when singular; ``A`` is laid out in
-        the solver's ``order`` attribute (default ``"F"``) and may be overwritten
-        (:mod:`continuation.linsolve`: direct LU or a kept LU with GMRES).
+        ``(A (n+1, n+1), B (n+1, k)) -> A^{-1} B`` or None when singular, ``A`` in the order of
+        its ``order`` attribute (default ``"F"``) (:mod:`continuation.linsolve`).
     evaluate_into : callable, optional
-        ``(xs, out (n, n+1)) -> Evaluation`` with ``Js`` written in ``out``; used when
-        ``linear_solve`` wants C order (and leaves ``A`` intact), so that the Jacobian lives
-        in the Newton matrix (:class:`_NewtonMatrices`).
+        ``(xs, out (n, n+1)) -> Evaluation`` writing ``Js`` in ``out``: with a C-order
+        ``linear_solve`` the Jacobian then lives in the Newton matrix (:class:`_NewtonMatrices`).
 
     Returns
     -------
@@ -252,41 +241,56 @@ def correct(evaluate: Callable[[np.ndarray], Evaluation], xs0: np.ndarray,
         # module doc) from a second right-hand side
         # (both right-hand sides are always written: one layout of B, one compiled kernel)
         sol = linear_solve(mats.matrix(ev, a, rho, g, B2), B2 if converged else B2[:, :1])
-        d_max = math.nan if sol is None else inf_norm(sol[:, 0])
-        if not math.isfinite(d_max):
-            if converged:
-                return Correction(True, ev, it, res, matrix=mats.holding(ev))
-            return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
-        delta = sol[:, 0]
-        if converged:
-            null = sol[:, 1]
-            if not math.isfinite(inf_norm(null)):
-                null = None
-            # free polishing update: error ~ |delta|^2, no further call of the function
-            return Correction(True, ev, it, res, xs=ev.xs + delta, null=null, matrix=mats.holding(ev))
-        if res <= sqrt_tol and d_max <= 16 * _EPS * size:
-            return Correction(True, ev, it, res, matrix=mats.holding(ev))
+        done = _solved(sol, converged, ev, it, res, res <= sqrt_tol, size, mats)
+        if done is not None:
+            return done
         # near the solution (merit below sqrt(tol)) a full step is taken whatever it gives:
         # there the merit grows only when a stick-slip switch moves between samples, which a
         # shorter step does not cure (it would cost up to max_backtrack more evaluations)
-        trial = _line_search(mats, constraint, ev.xs, delta, max(res, abs(g)), rho0, max_backtrack,
+        trial = _line_search(mats, constraint, ev.xs, sol[:, 0], max(res, abs(g)), rho0, max_backtrack,
                              backtrack_below)
         if not trial.finite:
             return Correction(False, ev, it + 1, res,
                               f"residual not finite along the Newton update (residual {res:.1e})")
         ev = trial
-    rho = max(rho0, ev.row_norm())
-    res = ev.r_max / rho
+    return _unconverged(ev, it, ev.r_max / max(rho0, ev.row_norm()), stalled, min(history), best,
+                        stall_factor * tol, mats)
+
+
+def _unconverged(ev: Evaluation, it: int, res: float, stalled: bool, lowest: float, best,
+                 accept: float, mats) -> Correction:
+    """The end of a correction that did not pass the test: the best iterate ``best = (res,
+    ev, it)`` if its residual is within ``accept`` and Newton did not stall, else a failure."""
     if stalled:
         # no acceptance of the best iterate here: a shorter step converges properly
         # (the best of a few cycling iterates can be off by far more than its residual says)
         return Correction(False, ev, it, res, f"Newton stalled after {it} iterations "
-                          f"(residual {res:.1e}, best {min(history):.1e})")
-    if best[0] <= stall_factor * tol:
+                          f"(residual {res:.1e}, best {lowest:.1e})")
+    if best[0] <= accept:
         ev = mats.fresh(best[1])
         return Correction(True, ev, best[2], best[0], matrix=mats.holding(ev))
-    return Correction(False, ev, max_iter, res,
-                      f"no convergence in {max_iter} iterations (residual {res:.1e})")
+    return Correction(False, ev, it, res, f"no convergence in {it} iterations (residual {res:.1e})")
+
+
+def _solved(sol, converged: bool, ev: Evaluation, it: int, res: float, near: bool, size: float,
+            mats) -> Correction | None:
+    """The correction that the Newton solve ``sol`` (n+1, 1 or 2) at ``ev`` ends with, or None
+    to go on: converged (with the free polishing update and the null vector), a singular
+    matrix, or an update at round-off (``near``: the residual is below ``sqrt(tol)``)."""
+    d_max = math.nan if sol is None else inf_norm(sol[:, 0])
+    if not math.isfinite(d_max):
+        if converged:
+            return Correction(True, ev, it, res, matrix=mats.holding(ev))
+        return Correction(False, ev, it, res, f"singular Newton matrix (residual {res:.1e})")
+    if converged:
+        null = sol[:, 1]
+        if not math.isfinite(inf_norm(null)):
+            null = None
+        # free polishing update: error ~ |delta|^2, no further call of the function
+        return Correction(True, ev, it, res, xs=ev.xs + sol[:, 0], null=null, matrix=mats.holding(ev))
+    if near and d_max <= 16 * _EPS * size:
+        return Correction(True, ev, it, res, matrix=mats.holding(ev))
+    return None
 
 
 def _line_search(mats, constraint, xs, delta, merit, rho0, max_backtrack, backtrack_below):
