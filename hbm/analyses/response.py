@@ -109,14 +109,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         hint = stiff_contact_hint(case)
         if hint:
             settings["contact_hint"] = hint
-    outputs_of = lambda X, w: recover_outputs(problem, case, X, w)      # noqa: E731
-    if len(pts.w) >= 2:
-        settings["fill_points_added"] = fill_long_steps(problem, pts, segments, outputs_of, (w_lo, w_hi),
-                                                        xscale, r_scale)
-    if len(pts.w) >= 3 and 1 in basis.harmonics:
-        rc = basis.row_of(1, "c")
-        settings["peak_points_added"] = refine_peaks(problem, pts, segments, outputs_of,
-                                                     lambda Y: np.hypot(Y[rc], Y[rc + 1]), xscale, r_scale)
+    _add_points(problem, case, pts, segments, (w_lo, w_hi), xscale, r_scale, settings)
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
     _closure_warning(settings, pts.unclosed, pts.w)
@@ -141,6 +134,20 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
                      jumps, eouts, Ys, stuck)
+
+
+def _add_points(problem, case, pts, segments, window, xscale, r_scale, settings) -> None:
+    """Points solved into the traced path ``pts`` where its steps are long (over ``window``,
+    rad/s) and next to its peaks; their counts go to ``settings``."""
+    outputs_of = lambda X, w: recover_outputs(problem, case, X, w)      # noqa: E731
+    if len(pts.w) >= 2:
+        settings["fill_points_added"] = fill_long_steps(problem, pts, segments, outputs_of, window,
+                                                        xscale, r_scale)
+    basis = problem.basis
+    if len(pts.w) >= 3 and 1 in basis.harmonics:
+        rc = basis.row_of(1, "c")
+        settings["peak_points_added"] = refine_peaks(problem, pts, segments, outputs_of,
+                                                     lambda Y: np.hypot(Y[rc], Y[rc + 1]), xscale, r_scale)
 
 
 STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact

@@ -218,26 +218,8 @@ def build_assembly(beams=(), bodies=(), springs=(), sparse=None) -> Assembly:
             nodes[f"{pre}n{k}"] = None     # filled below from the DOF names
         offset += m.n_dof
     for i, spec in enumerate(bodies):
-        where = f"[[model.body]] #{i}"
-        _check(spec, BODY_KEYS, where)
-        for k in ("name", "mass"):
-            if k not in spec:
-                raise ValueError(f"{where}: missing key {k!r}")
-        name = spec["name"]
-        if not isinstance(name, str) or not name or "." in name or name in seen or name == "ground":
-            raise ValueError(f"{where}: name must be a new non-empty string without dots, got {name!r}")
+        name, diag, labs = _body(spec, f"[[model.body]] #{i}", seen)
         seen.add(name)
-        mass = _vector(spec["mass"], 1, f"{where}: mass")[0]
-        if not mass > 0:
-            raise ValueError(f"{where}: mass must be positive, got {spec['mass']!r}")
-        diag = [mass] * 3
-        labs = ["ux", "uy", "uz"]
-        if "inertia" in spec:
-            inertia = _vector(spec["inertia"], 3, f"{where}: inertia")
-            if np.any(inertia <= 0):
-                raise ValueError(f"{where}: inertia must be positive")
-            diag += list(inertia)
-            labs += ["rx", "ry", "rz"]
         Ms.append(sp.diags(diag).tocsr()); Ks.append(sp.csr_matrix((len(diag), len(diag))))
         names += [f"{name}.{lab}" for lab in labs]
         points[name] = tuple({offset + j: 1.0} for j in range(3))
@@ -248,56 +230,88 @@ def build_assembly(beams=(), bodies=(), springs=(), sparse=None) -> Assembly:
     M = sp.block_diag(Ms, format="csr")
     K = sp.block_diag(Ks, format="lil")
 
-    def end_rows(ref, where):
-        """Rows (6, n) of a spring end: translations then rotations (rotations NaN-free zeros)."""
-        R = np.zeros((6, n))
-        has_rot = False
-        if ref == "ground":
-            return R, True
-        if ref in points and ref not in nodes:
-            for i, row in enumerate(points[ref]):
-                for j, c in row.items():
-                    R[i, j] = c
-            return R, False
-        if ref in nodes:
-            for i, lab in enumerate(("ux", "uy", "uz", "rx", "ry", "rz")):
-                j = index.get(f"{ref}.{lab}")
-                if j is not None:
-                    R[i, j] = 1.0
-                    has_rot = has_rot or i >= 3
-            # a clamped node (all DOFs removed) is ground; a body without inertia has no rotations
-            return R, has_rot or not np.any(R)
-        raise ValueError(f"{where}: unknown spring end {ref!r} (a node like 'blade1.n3', a point, "
-                         f"a body or 'ground')")
-
+    end_rows = lambda ref, where: _end_rows(ref, where, points, nodes, index, n)   # noqa: E731
     for i, spec in enumerate(springs):
-        where = f"[[model.spring]] #{i}"
-        _check(spec, SPRING_KEYS, where)
-        for k in ("between", "k"):
-            if k not in spec:
-                raise ValueError(f"{where}: missing key {k!r}")
-        ends = spec["between"]
-        if not isinstance(ends, list) or len(ends) not in (1, 2) or not all(isinstance(e, str) for e in ends):
-            raise ValueError(f"{where}: between must be [a, b] or [a] (to ground) with names")
-        a, b = (ends + ["ground"])[:2]
-        Ra, rot_a = end_rows(a, where)
-        Rb, rot_b = end_rows(b, where)
-        kt = _vector(spec["k"], 3, f"{where}: k")
-        kr = _vector(spec.get("k_rot", 0.0), 3, f"{where}: k_rot")
-        if np.any(kt < 0) or np.any(kr < 0):
-            raise ValueError(f"{where}: k and k_rot must be >= 0")
-        if np.any(kr > 0) and not (rot_a and rot_b):
-            raise ValueError(f"{where}: k_rot needs ends with rotations (nodes, bodies with inertia, ground)")
-        G = Ra - Rb
-        kk = np.r_[kt, kr]
-        if not np.any(G):
-            raise ValueError(f"{where}: the spring ends do not move (both clamped or identical)")
-        nz = np.flatnonzero(np.any(G != 0, axis=0))
-        Gs = G[:, nz]
-        K[np.ix_(nz, nz)] = K[np.ix_(nz, nz)].toarray() + (Gs.T * kk) @ Gs
+        nz, Ks_ = _spring(spec, f"[[model.spring]] #{i}", end_rows)
+        K[np.ix_(nz, nz)] = K[np.ix_(nz, nz)].toarray() + Ks_
     K = K.tocsr()
     use_sparse = n > DENSE_MAX_DOF if sparse is None else bool(sparse)
     if not use_sparse:
         M, K = M.toarray(), K.toarray()
         M, K = 0.5 * (M + M.T), 0.5 * (K + K.T)
     return Assembly(M, K, tuple(names), points)
+
+
+def _end_rows(ref, where, points, nodes, index, n):
+    """Rows (6, n) of a spring end: translations then rotations (rotations NaN-free zeros),
+    and whether the end has rotations."""
+    R = np.zeros((6, n))
+    has_rot = False
+    if ref == "ground":
+        return R, True
+    if ref in points and ref not in nodes:
+        for i, row in enumerate(points[ref]):
+            for j, c in row.items():
+                R[i, j] = c
+        return R, False
+    if ref in nodes:
+        for i, lab in enumerate(("ux", "uy", "uz", "rx", "ry", "rz")):
+            j = index.get(f"{ref}.{lab}")
+            if j is not None:
+                R[i, j] = 1.0
+                has_rot = has_rot or i >= 3
+        # a clamped node (all DOFs removed) is ground; a body without inertia has no rotations
+        return R, has_rot or not np.any(R)
+    raise ValueError(f"{where}: unknown spring end {ref!r} (a node like 'blade1.n3', a point, "
+                     f"a body or 'ground')")
+
+
+def _body(spec: dict, where: str, seen: set):
+    """``(name, diagonal masses, DOF labels)`` of a ``[[model.body]]`` table."""
+    _check(spec, BODY_KEYS, where)
+    for k in ("name", "mass"):
+        if k not in spec:
+            raise ValueError(f"{where}: missing key {k!r}")
+    name = spec["name"]
+    if not isinstance(name, str) or not name or "." in name or name in seen or name == "ground":
+        raise ValueError(f"{where}: name must be a new non-empty string without dots, got {name!r}")
+    mass = _vector(spec["mass"], 1, f"{where}: mass")[0]
+    if not mass > 0:
+        raise ValueError(f"{where}: mass must be positive, got {spec['mass']!r}")
+    diag = [mass] * 3
+    labs = ["ux", "uy", "uz"]
+    if "inertia" in spec:
+        inertia = _vector(spec["inertia"], 3, f"{where}: inertia")
+        if np.any(inertia <= 0):
+            raise ValueError(f"{where}: inertia must be positive")
+        diag += list(inertia)
+        labs += ["rx", "ry", "rz"]
+    return name, diag, labs
+
+
+def _spring(spec: dict, where: str, end_rows):
+    """The coordinates ``nz`` a ``[[model.spring]]`` couples and its stiffness block there,
+    ``G^T diag(k, k_rot) G`` with ``G`` the difference of its ends' rows."""
+    _check(spec, SPRING_KEYS, where)
+    for k in ("between", "k"):
+        if k not in spec:
+            raise ValueError(f"{where}: missing key {k!r}")
+    ends = spec["between"]
+    if not isinstance(ends, list) or len(ends) not in (1, 2) or not all(isinstance(e, str) for e in ends):
+        raise ValueError(f"{where}: between must be [a, b] or [a] (to ground) with names")
+    a, b = (ends + ["ground"])[:2]
+    Ra, rot_a = end_rows(a, where)
+    Rb, rot_b = end_rows(b, where)
+    kt = _vector(spec["k"], 3, f"{where}: k")
+    kr = _vector(spec.get("k_rot", 0.0), 3, f"{where}: k_rot")
+    if np.any(kt < 0) or np.any(kr < 0):
+        raise ValueError(f"{where}: k and k_rot must be >= 0")
+    if np.any(kr > 0) and not (rot_a and rot_b):
+        raise ValueError(f"{where}: k_rot needs ends with rotations (nodes, bodies with inertia, ground)")
+    G = Ra - Rb
+    kk = np.r_[kt, kr]
+    if not np.any(G):
+        raise ValueError(f"{where}: the spring ends do not move (both clamped or identical)")
+    nz = np.flatnonzero(np.any(G != 0, axis=0))
+    Gs = G[:, nz]
+    return nz, (Gs.T * kk) @ Gs

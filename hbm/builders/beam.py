@@ -286,18 +286,7 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
                          f"(a finer model belongs in a model file and the condensed solver)")
     if not length > 0:
         raise ValueError(f"length must be positive, got {length}")
-    rect = width is not None or height is not None
-    props = (area, Iy, Iz, J)
-    if rect and any(p is not None for p in props):
-        raise ValueError("give either width/height or area/Iy/Iz/J for the section, not both")
-    if rect:
-        if width is None or height is None:
-            raise ValueError("a rectangular section needs both width and height")
-        section = Section.rectangle(float(width), float(height))
-    else:
-        if any(p is None for p in props):
-            raise ValueError("section needs area, Iy, Iz and J (or width and height)")
-        section = Section(*(float(p) for p in props))
+    section = _section(area, Iy, Iz, J, width, height)
     material = Material(float(E), float(nu), float(rho))
 
     ax = np.asarray(axis, dtype=float)
@@ -313,9 +302,44 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
     if clamp and (clamp[0] < 0 or clamp[-1] >= n_nodes):
         raise ValueError(f"clamp nodes must be in 0..{n_nodes - 1}, got {clamp}")
 
+    Kall, Mall = _assembled(coords, up, length / n_el, n_el, section, material, lumped_mass)
+    all_names = [f"n{i}.{lab}" for i in range(n_nodes) for lab in DOF_LABELS]
+    pts = _named_points(points, n_nodes)
+    Mall = (Mall + _point_mass_matrix(point_masses, pts, all_names, n_nodes)).tocsr()
+    fixed = np.zeros(6 * n_nodes, dtype=bool)
+    for c in clamp:
+        fixed[6 * c:6 * c + 6] = True
+    free = np.flatnonzero(~fixed)
+    K, M = Kall[free][:, free], Mall[free][:, free]
+    if (free.size > DENSE_MAX_DOF if sparse is None else bool(sparse)):
+        K, M = K.tocsr(), M.tocsr()
+    else:
+        K, M = K.toarray(), M.toarray()
+        K, M = 0.5 * (K + K.T), 0.5 * (M + M.T)
+    return BeamModel(M, K, tuple(all_names[i] for i in free), coords, pts)
+
+
+def _section(area, Iy, Iz, J, width, height) -> Section:
+    """The cross-section from ``area, Iy, Iz, J`` or from a solid rectangle ``width x height``."""
+    rect = width is not None or height is not None
+    props = (area, Iy, Iz, J)
+    if rect and any(p is not None for p in props):
+        raise ValueError("give either width/height or area/Iy/Iz/J for the section, not both")
+    if rect:
+        if width is None or height is None:
+            raise ValueError("a rectangular section needs both width and height")
+        return Section.rectangle(float(width), float(height))
+    if any(p is None for p in props):
+        raise ValueError("section needs area, Iy, Iz and J (or width and height)")
+    return Section(*(float(p) for p in props))
+
+
+def _assembled(coords, up, le: float, n_el: int, section, material, lumped_mass: bool):
+    """Global stiffness and mass ``(K, M)`` (6 (n_el + 1) square, CSR) of the straight beam."""
+    n_nodes = n_el + 1
     R = local_axes(coords[0], coords[1], up)
     T = np.kron(np.eye(4), R)
-    ke, me = element_matrices(length / n_el, section, material, lumped_mass)
+    ke, me = element_matrices(le, section, material, lumped_mass)
     ke, me = T.T @ ke @ T, T.T @ me @ T
     n_all = 6 * n_nodes
     rows, cols, kv, mv = [], [], [], []
@@ -327,8 +351,11 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
     rows, cols = np.concatenate(rows), np.concatenate(cols)
     Kall = sp.coo_matrix((np.concatenate(kv), (rows, cols)), shape=(n_all, n_all)).tocsr()
     Mall = sp.coo_matrix((np.concatenate(mv), (rows, cols)), shape=(n_all, n_all)).tocsr()
+    return Kall, Mall
 
-    all_names = [f"n{i}.{lab}" for i in range(n_nodes) for lab in DOF_LABELS]
+
+def _named_points(points, n_nodes: int) -> dict:
+    """``{name: (node, offset (3,))}`` checked against the node range."""
     pts = {}
     for name, spec in (points or {}).items():
         try:
@@ -340,7 +367,12 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
             raise ValueError(f"point {name!r} node {node} is outside 0..{n_nodes - 1}")
         pts[str(name)] = (node, np.asarray(offset, dtype=float).copy())
         rigid_offset_rows(pts[str(name)][1])   # validates the shape
+    return pts
 
+
+def _point_mass_matrix(point_masses, pts, all_names, n_nodes: int):
+    """Mass matrix (CSR, all DOFs) of the point masses on nodes or named points."""
+    n_all = 6 * n_nodes
     extra = sp.lil_matrix((n_all, n_all))
     for key, mass in (point_masses or {}).items():
         if not (np.isfinite(mass) and mass > 0):
@@ -357,20 +389,5 @@ def build_beam_model(*, length, n_elements, E, rho, nu=0.3, area=None, Iy=None, 
                 raise ValueError(f"point mass node {node} is outside 0..{n_nodes - 1}")
             for j in range(3):
                 extra[6 * node + j, 6 * node + j] += mass
-    Mall = (Mall + extra.tocsr()).tocsr()
+    return extra.tocsr()
 
-    fixed = np.zeros(n_all, dtype=bool)
-    for c in clamp:
-        fixed[6 * c:6 * c + 6] = True
-    free = np.flatnonzero(~fixed)
-    K = Kall[free][:, free]
-    M = Mall[free][:, free]
-    names = tuple(all_names[i] for i in free)
-    use_sparse = free.size > DENSE_MAX_DOF if sparse is None else bool(sparse)
-    if use_sparse:
-        K, M = K.tocsr(), M.tocsr()
-    else:
-        K, M = K.toarray(), M.toarray()
-        K = 0.5 * (K + K.T)
-        M = 0.5 * (M + M.T)
-    return BeamModel(M, K, names, coords, pts)

@@ -59,6 +59,18 @@ def _ints(line):
 OP4_BYTES_PER_FILE_BYTE = 6      # text, its lines, and the parsed entries, per byte of the file
 
 
+def _check_readable(path: Path) -> None:
+    """ValueError unless ``path`` is a file this machine has the memory to read."""
+    if not path.is_file():
+        raise ValueError(f"OP4 file not found: {path}")
+    from hbm.analyses.budget import MEMORY_SHARE, machine_memory
+    need = OP4_BYTES_PER_FILE_BYTE * path.stat().st_size
+    if need > MEMORY_SHARE * machine_memory():
+        raise ValueError(f"{path}: an ASCII OP4 file of {path.stat().st_size / 1e9:.3g} GB needs about "
+                         f"{need / 1e9:.3g} GB to read (this machine has {machine_memory() / 1e9:.3g} GB): "
+                         f"write the matrices sparse, or use Matrix Market files")
+
+
 def read_op4(path) -> dict:
     """Read all matrices of an ASCII OP4 file.
 
@@ -69,14 +81,7 @@ def read_op4(path) -> dict:
         for the column-sparse layout; shape (NROW, NCOL).
     """
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"OP4 file not found: {path}")
-    from hbm.analyses.budget import MEMORY_SHARE, machine_memory
-    need = OP4_BYTES_PER_FILE_BYTE * path.stat().st_size
-    if need > MEMORY_SHARE * machine_memory():
-        raise ValueError(f"{path}: an ASCII OP4 file of {path.stat().st_size / 1e9:.3g} GB needs about "
-                         f"{need / 1e9:.3g} GB to read (this machine has {machine_memory() / 1e9:.3g} GB): "
-                         f"write the matrices sparse, or use Matrix Market files")
+    _check_readable(path)
     lines = path.read_text().splitlines()
     out = {}
     i = 0

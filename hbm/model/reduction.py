@@ -256,6 +256,22 @@ def reduce_model(M, K, *, n_modes=None, residual_flexibility=True, modal_damping
     if names and len(names) != n:
         raise ValueError(f"dof_names has {len(names)} names for {n} DOFs")
 
+    lam, Phi = _modes(M, K, n_modes, sparse, sigma)
+    omega = np.sqrt(lam)
+
+    Cm = _modal_damping(Phi, lam, omega, n, modal_damping, rayleigh, damping)
+
+    phi_k = np.ascontiguousarray(Phi[keep])
+    R = (_residual_flexibility(K, keep, phi_k, lam, sparse) if residual_flexibility
+         else np.zeros((keep.size, keep.size)))
+    kept_names = tuple(names[i] for i in keep) if names else ()
+    return ReducedModel(keep, omega, phi_k, np.ascontiguousarray(Cm), R, n, kept_names)
+
+
+def _modes(M, K, n_modes: int, sparse: bool, sigma: float):
+    """The ``n_modes`` lowest eigenpairs ``(lam (m,), Phi (n, m))`` of ``K phi = lam M phi``,
+    mass-normalised; ValueError for a negative or singular stiffness."""
+    n = M.shape[0]
     if sparse:
         # a fixed start vector: ARPACK's random one made two runs of one case differ at
         # round-off, enough to change a continuation's steps (and its points) between runs
@@ -273,9 +289,13 @@ def reduce_model(M, K, *, n_modes=None, residual_flexibility=True, modal_damping
                          f"eigenvalue {lam.min():.3g} (rad/s)^2")
     if lam.min() <= 1e-12 * max(abs(lam.max()), 1e-300):
         raise ValueError("stiffness matrix is singular (free-free structure?): clamp it first")
-    Phi = Phi / np.sqrt(np.einsum("ir,ir->r", Phi, M @ Phi))
-    omega = np.sqrt(lam)
+    return lam, Phi / np.sqrt(np.einsum("ir,ir->r", Phi, M @ Phi))
 
+
+def _modal_damping(Phi, lam, omega, n: int, modal_damping, rayleigh, damping) -> np.ndarray:
+    """Modal damping matrix (m, m) from ratios, Rayleigh coefficients or a viscous matrix
+    (zero without any); ValueError when it would be negative."""
+    n_modes = omega.size
     if modal_damping is not None:
         z = np.asarray(modal_damping, dtype=float)
         if z.ndim > 1 or (z.ndim == 1 and z.size != n_modes):
@@ -302,21 +322,21 @@ def reduce_model(M, K, *, n_modes=None, residual_flexibility=True, modal_damping
                              f"its modal projection has eigenvalue {cm[0]:.3g}")
     else:
         Cm = np.zeros((n_modes, n_modes))
+    return Cm
 
-    phi_k = np.ascontiguousarray(Phi[keep])
-    if residual_flexibility:
-        E = np.zeros((n, keep.size))
-        E[keep, np.arange(keep.size)] = 1.0
-        if sparse:
-            Kinv = spla.splu(K.tocsc()).solve(E)[keep]
-        else:
-            Kinv = sla.solve(K, E, assume_a="sym")[keep]
-        R = Kinv - (phi_k / lam) @ phi_k.T
-        R = 0.5 * (R + R.T)
+
+def _residual_flexibility(K, keep, phi_k, lam, sparse: bool) -> np.ndarray:
+    """Static flexibility of the truncated modes at the kept DOFs, ``K^-1 - Phi_k Lam^-1
+    Phi_k^T`` (k, k), symmetrised."""
+    n = K.shape[0]
+    E = np.zeros((n, keep.size))
+    E[keep, np.arange(keep.size)] = 1.0
+    if sparse:
+        Kinv = spla.splu(K.tocsc()).solve(E)[keep]
     else:
-        R = np.zeros((keep.size, keep.size))
-    kept_names = tuple(names[i] for i in keep) if names else ()
-    return ReducedModel(keep, omega, phi_k, np.ascontiguousarray(Cm), R, n, kept_names)
+        Kinv = sla.solve(K, E, assume_a="sym")[keep]
+    R = Kinv - (phi_k / lam) @ phi_k.T
+    return 0.5 * (R + R.T)
 
 
 def reduce_linear_model(model, *, n_modes=None, residual_flexibility=True, keep_dofs=None):
