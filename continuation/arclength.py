@@ -230,8 +230,10 @@ class Arclength:
         c, t = self._start(self.x0 / self.scale)
         if c is None:
             return
-        yield self._point(c, t, 0.0, False, on_bound=c.xs[-1] in (lo_s, hi_s))
         xs = c.xs
+        pt = self._point(c, t, 0.0, False, on_bound=xs[-1] in (lo_s, hi_s))
+        c = None            # no Jacobian held while the caller works on the point
+        yield pt
         lam_prev_sign = _sign(t[-1])
         ds = self.ds0
         steps = 0
@@ -273,20 +275,23 @@ class Arclength:
                 lam_f = fold_parameter(xs[-1], c.xs[-1], t[-1], t_new[-1], _norm(c.xs - xs))
                 self.folds.append(float(lam_f * s_lam))
             lam_prev_sign = sign_new or lam_prev_sign
-            yield self._point(c, t_new, ds, fold, on_bound=on_bound)
+            pt = self._point(c, t_new, ds, fold, on_bound=on_bound)
+            c_xs, c_its = c.xs, c.iterations
+            c = out = None      # no Jacobian held while the caller works on the point
+            yield pt
             if on_bound:
                 self.status = "finished"
                 self.message = (f"parameter left the bounds; last point solved on "
-                                f"{self._lam(c.xs[-1] * s_lam)} after {steps} steps, "
+                                f"{self._lam(c_xs[-1] * s_lam)} after {steps} steps, "
                                 f"{len(self.folds)} folds, {self.n_rejected} rejections")
                 return
-            xs, t = c.xs, t_new
+            xs, t = c_xs, t_new
             # a step shorter than the last rejected turn approaches a corner: keep the
             # memory, so that the same turn at a smaller ds is recognised as a kink
             # (otherwise the path creeps towards the corner in ever shorter steps)
             if angle_reject is not None and not ds < angle_reject[0]:
                 angle_reject = None
-            ds = self._next_ds(ds, c.iterations, angle, consecutive)
+            ds = self._next_ds(ds, c_its, angle, consecutive)
             consecutive = 0
 
     def _start(self, xs):

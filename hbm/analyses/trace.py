@@ -63,6 +63,7 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
     if explained < 0.1 * abs(eb.excitation - eb.viscous - eb.nonlinear):
         return X, err
     calls = iter([first])                     # Newton's first call gets the evaluation at hand
+    del first                                 # (its Jacobian is then not held past that call)
     res = newton(lambda u: next(calls, None) or bordered(u), x0, scale=np.r_[xscale, w_scale],
                  r_scale=r_scale, tol=1e-13, max_iter=4, linear_solve=linear_solve, overwrite_jacobian=True)
     if np.all(np.isfinite(res.x)):
