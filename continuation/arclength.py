@@ -25,7 +25,10 @@ halved without going under ``ds_min``.  Accepted steps adapt ``ds`` as in
 
 Bounds: when the predictor (or the corrected point) leaves :math:`[\lambda_{lo},
 \lambda_{hi}]`, the last point is solved with :math:`\lambda` fixed on the bound, starting
-from the chord's crossing of the bound, and the run ends with status ``'finished'``.
+from the chord's crossing of the bound, and the run ends with status ``'finished'``.  A
+corrected point outside the bounds counts only if it lies within ``max_correction * ds`` of
+its predictor and :math:`\lambda` moved along :math:`t_\lambda`: a long step's hyperplane can
+cut the path again beyond the other bound (a branch jump, refused like any other).
 
 Parameter-step limit (optional ``lam_step``): the caller may know where the path has
 features narrower than the step control can see from two end points, e.g. the linear
