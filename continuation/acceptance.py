@@ -35,8 +35,8 @@ class Step(NamedTuple):
 
     Parameters
     ----------
-    c : Correction
-        The corrector's result.
+    c : Correction or None
+        The corrector's result (None in a refused step whose correction was let go).
     t_new : ndarray, shape (n+1,), or None
         New unit tangent (None when the step failed before it was computed).
     angle : float
@@ -49,7 +49,7 @@ class Step(NamedTuple):
         Refused only for turning by more than ``max_angle_deg`` (a shorter step may pass).
     """
 
-    c: Correction
+    c: Correction | None
     t_new: np.ndarray | None
     angle: float
     reason: str | None

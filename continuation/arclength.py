@@ -322,6 +322,8 @@ class Arclength:
         if out.reason is not None and consecutive >= 1 and not out.on_bound:
             # repeated trouble at this point: maybe a sharp corner of the path, which a
             # hyperplane normal to t cannot cross; try a sphere around the last point
+            # (the refused step's correction, and its Newton matrix, are let go first)
+            out = out._replace(c=None)
             out2 = self._step(xs, t, ds, angle_reject, True)
             if out2.reason is None or out2.turned:
                 return out2
