@@ -79,7 +79,6 @@ def brush_march(kt, kn, mu, nt, pre, weight, coef, z, dz, start, max_passes, tol
     """
     N, nl = z.shape
     P = dz.shape[2]
-    nb_ = pre.shape[0]
     ns = 2 * nt + 1
     f = np.zeros((N, nl))
     df = np.zeros((N, nl, P))
@@ -89,85 +88,130 @@ def brush_march(kt, kn, mu, nt, pre, weight, coef, z, dz, start, max_passes, tol
     un = np.empty(N)
     zb = np.empty((N, nt + 1))
     dzb = np.empty((N, nt + 1, P))
-    pb = np.empty(5)
-    pb[0] = kt
-    pb[1] = kn
-    pb[2] = mu
-    pb[4] = nt
-    # elastic tangential force magnitude from rest, per sample (same for every bristle)
-    ftr = np.empty(N)
-    for j in range(N):
-        g2 = 0.0
-        for a in range(nt):
-            g2 += (kt * z[j, a]) ** 2
-        ftr[j] = np.sqrt(g2)
+    pb = np.empty(5)                     # the friction3d record: kt, kn, mu, preload, nt
+    pb[0], pb[1], pb[2], pb[4] = kt, kn, mu, nt
+    ftr = _elastic_from_rest(kt, nt, z)
     worst = 0
-    for b in range(nb_):
+    for b in range(pre.shape[0]):
         w = weight[b]
         p = pre[b]
-        closed_all = True
-        open_all = True
-        stuck = True
-        for j in range(N):
-            s = 0.0
-            for c in range(nt, nl):
-                s += coef[b, c] * z[j, c]
-            un[j] = s
-            load = p + kn * s
-            if load > 0.0:
-                open_all = False
-                if ftr[j] > mu * load:
-                    stuck = False
-            else:
-                closed_all = False
-        rest = -p if p > 0.0 else 0.0          # -max(p, 0)
-        off = p if p < 0.0 else 0.0            # min(p, 0): N_b - max(p, 0) = kn u_n + off
-        if open_all:
+        state = _bristle_state(kn, mu, nt, p, coef[b], z, ftr, un)
+        if state == 0:                          # open all period: its rest force
             counts[0] += int(w)
             for c in range(nt, nl):
-                f0[c] += w * coef[b, c] * rest
+                f0[c] += w * coef[b, c] * (-p if p > 0.0 else 0.0)      # -max(p, 0)
             continue
-        if closed_all and stuck:
+        if state == 1:                          # loaded and stuck all period: linear
             counts[1] += int(w)
-            for a in range(nt):
-                Kst[a, a] += w * kt
-            for c in range(nt, nl):
-                f0[c] += w * coef[b, c] * off
-                for d in range(nt, nl):
-                    Kst[c, d] += w * kn * coef[b, c] * coef[b, d]
+            _add_stuck(Kst, f0, w, kt, kn, nt, p, coef[b])
             continue
         counts[2] += int(w)
-        for j in range(N):
-            for a in range(nt):
-                zb[j, a] = z[j, a]
-                for q in range(P):
-                    dzb[j, a, q] = dz[j, a, q]
-            zb[j, nt] = un[j]
-            for q in range(P):
-                s = 0.0
-                for c in range(nt, nl):
-                    s += coef[b, c] * dz[j, c, q]
-                dzb[j, nt, q] = s
+        _bristle_inputs(nt, coef[b], z, dz, un, zb, dzb)
         pb[3] = p
         fb, dfb, passes = march_newton(FRICTION3D, pb, ns, nt + 1, zb, dzb, start, max_passes, tol)
         if passes < 0:
             worst = passes if worst >= 0 or passes < worst else worst
         elif worst >= 0 and passes > worst:
             worst = passes
-        for j in range(N):
-            for a in range(nt):
-                f[j, a] += w * fb[j, a]
-                for q in range(P):
-                    df[j, a, q] += w * dfb[j, a, q]
-            fn = fb[j, nt]
-            for c in range(nt, nl):
-                wc = w * coef[b, c]
-                if wc != 0.0:
-                    f[j, c] += wc * fn
-                    for q in range(P):
-                        df[j, c, q] += wc * dfb[j, nt, q]
+        _add_marched(f, df, w, nt, coef[b], fb, dfb)
     counts[3] = worst
-    # stuck bristles: one linear map; open/stuck constants
+    _add_linear(f, df, f0, Kst, z, dz)
+    return f, df, counts
+
+
+@nb.njit(cache=True)
+def _elastic_from_rest(kt, nt, z):
+    """``|kt u_t|`` per sample (N,): the elastic tangential force from rest (every bristle's)."""
+    N = z.shape[0]
+    ftr = np.empty(N)
+    for j in range(N):
+        g2 = 0.0
+        for a in range(nt):
+            g2 += (kt * z[j, a]) ** 2
+        ftr[j] = np.sqrt(g2)
+    return ftr
+
+
+@nb.njit(cache=True)
+def _bristle_state(kn, mu, nt, p, coef_b, z, ftr, un):
+    """0: open all period, 1: loaded and inside its cone all period (never slips), 2: marched.
+    Writes the bristle's approach ``u_{n,b}`` per sample into ``un`` (N,)."""
+    N, nl = z.shape
+    closed_all = True
+    open_all = True
+    stuck = True
+    for j in range(N):
+        s = 0.0
+        for c in range(nt, nl):
+            s += coef_b[c] * z[j, c]
+        un[j] = s
+        load = p + kn * s
+        if load > 0.0:
+            open_all = False
+            if ftr[j] > mu * load:
+                stuck = False
+        else:
+            closed_all = False
+    if open_all:
+        return 0
+    return 1 if closed_all and stuck else 2
+
+
+@nb.njit(cache=True)
+def _add_stuck(Kst, f0, w, kt, kn, nt, p, coef_b):
+    """A stuck bristle's stiffness into ``Kst`` (nl, nl) and its constant into ``f0`` (nl,)."""
+    nl = f0.shape[0]
+    off = p if p < 0.0 else 0.0            # min(p, 0): N_b - max(p, 0) = kn u_n + off
+    for a in range(nt):
+        Kst[a, a] += w * kt
+    for c in range(nt, nl):
+        f0[c] += w * coef_b[c] * off
+        for d in range(nt, nl):
+            Kst[c, d] += w * kn * coef_b[c] * coef_b[d]
+
+
+@nb.njit(cache=True)
+def _bristle_inputs(nt, coef_b, z, dz, un, zb, dzb):
+    """The bristle's march inputs ``zb`` (N, nt+1) = ``[u_t, u_{n,b}]`` and their seeds ``dzb``."""
+    N, nl = z.shape
+    P = dz.shape[2]
+    for j in range(N):
+        for a in range(nt):
+            zb[j, a] = z[j, a]
+            for q in range(P):
+                dzb[j, a, q] = dz[j, a, q]
+        zb[j, nt] = un[j]
+        for q in range(P):
+            s = 0.0
+            for c in range(nt, nl):
+                s += coef_b[c] * dz[j, c, q]
+            dzb[j, nt, q] = s
+
+
+@nb.njit(cache=True)
+def _add_marched(f, df, w, nt, coef_b, fb, dfb):
+    """A marched bristle's forces ``fb`` (N, nt+1) and seeds into the resultants (module doc)."""
+    N, nl = f.shape
+    P = df.shape[2]
+    for j in range(N):
+        for a in range(nt):
+            f[j, a] += w * fb[j, a]
+            for q in range(P):
+                df[j, a, q] += w * dfb[j, a, q]
+        fn = fb[j, nt]
+        for c in range(nt, nl):
+            wc = w * coef_b[c]
+            if wc != 0.0:
+                f[j, c] += wc * fn
+                for q in range(P):
+                    df[j, c, q] += wc * dfb[j, nt, q]
+
+
+@nb.njit(cache=True)
+def _add_linear(f, df, f0, Kst, z, dz):
+    """The stuck bristles' one linear map and the open/stuck constants: ``f += f0 + Kst z``."""
+    N, nl = z.shape
+    P = dz.shape[2]
     for j in range(N):
         for a in range(nl):
             s = f0[a]
@@ -179,4 +223,3 @@ def brush_march(kt, kn, mu, nt, pre, weight, coef, z, dz, start, max_passes, tol
                 if k != 0.0:
                     for q in range(P):
                         df[j, a, q] += k * dz[j, c, q]
-    return f, df, counts
