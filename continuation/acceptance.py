@@ -95,7 +95,7 @@ def judge_step(c: Correction, xs, t, start, ds: float, sphere: bool, on_bound: b
     if fast:
         t_new = c.null * f
     else:
-        u = null_tangent(c.ev.Js, t, c.matrix)           # consumes c.ev.Js
+        u = null_tangent(c.ev.Js, t, c.matrix, c.ev.row_norm())     # consumes c.ev.Js
         if u is None:
             return Step(c, None, 0.0, "the tangent system is singular", on_bound)
         _, _, _, cosang, f = step_geometry(xs, t, c.xs, start, u)

@@ -309,7 +309,7 @@ class Arclength:
             return None, None
         e = np.zeros_like(xs)
         e[-1] = self.direction
-        t = null_tangent(c.ev.Js, e, c.matrix)
+        t = null_tangent(c.ev.Js, e, c.matrix, c.ev.row_norm())
         if t is None:
             self._fail(f"the path's tangent at the starting point {self._lam(self.x0[-1])} is "
                        f"undefined (singular bordered system)")

@@ -98,19 +98,6 @@ def border_rows(R, a, rho, g, A, B):
 
 
 @nb.njit(cache=True)
-def row_sum_norm(A):
-    """``||A||_inf`` (largest absolute row sum) of a 2-D array, without a temporary."""
-    norm = 0.0
-    for i in range(A.shape[0]):
-        s = 0.0
-        for j in range(A.shape[1]):
-            s += abs(A[i, j])
-        if s > norm:
-            norm = s
-    return norm
-
-
-@nb.njit(cache=True)
 def inf_norm(x):
     """``max |x_i|``; NaN when ``x`` holds a NaN or inf."""
     r = 0.0

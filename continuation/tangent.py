@@ -28,10 +28,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
 
-from .kernels import row_sum_norm
 
-
-def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = None) -> np.ndarray:
+def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = None,
+                 rho: float | None = None) -> np.ndarray:
     """Unit null vector of ``Js`` with a positive component along ``t_ref``.
 
     Parameters
@@ -44,6 +43,9 @@ def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = No
         C-ordered array whose first ``n`` rows are ``Js`` (the corrector's Newton matrix,
         :attr:`continuation.corrector.Correction.matrix`): the bordered system is built and
         factored in it, so ``Js`` is consumed and no ``(n+1)^2`` array is allocated.
+    rho : float, optional
+        ``||Js||_inf`` when the caller has it (:meth:`continuation.corrector.Evaluation.row_norm`);
+        computed otherwise.
 
     Returns
     -------
@@ -53,7 +55,9 @@ def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = No
         vector of ``Js`` is returned then).
     """
     n = Js.shape[0]
-    rho = max(row_sum_norm(Js), 1e-300)
+    if rho is None:
+        rho = float(np.abs(Js).sum(axis=1).max(initial=0.0))
+    rho = max(rho, 1e-300)
     rhs = np.zeros(n + 1)
     rhs[-1] = rho
     if work is not None:

@@ -257,15 +257,13 @@ def reduce_model(M, K, *, n_modes=None, residual_flexibility=True, modal_damping
         raise ValueError(f"dof_names has {len(names)} names for {n} DOFs")
 
     lam, Phi = _modes(M, K, n_modes, sparse, sigma)
-    omega = np.sqrt(lam)
-
-    Cm = _modal_damping(Phi, lam, omega, n, modal_damping, rayleigh, damping)
+    Cm = _modal_damping(Phi, lam, n, modal_damping, rayleigh, damping)
 
     phi_k = np.ascontiguousarray(Phi[keep])
     R = (_residual_flexibility(K, keep, phi_k, lam, sparse) if residual_flexibility
          else np.zeros((keep.size, keep.size)))
     kept_names = tuple(names[i] for i in keep) if names else ()
-    return ReducedModel(keep, omega, phi_k, np.ascontiguousarray(Cm), R, n, kept_names)
+    return ReducedModel(keep, np.sqrt(lam), phi_k, np.ascontiguousarray(Cm), R, n, kept_names)
 
 
 def _modes(M, K, n_modes: int, sparse: bool, sigma: float):
@@ -292,16 +290,17 @@ def _modes(M, K, n_modes: int, sparse: bool, sigma: float):
     return lam, Phi / np.sqrt(np.einsum("ir,ir->r", Phi, M @ Phi))
 
 
-def _modal_damping(Phi, lam, omega, n: int, modal_damping, rayleigh, damping) -> np.ndarray:
+def _modal_damping(Phi, lam, n: int, modal_damping, rayleigh, damping) -> np.ndarray:
     """Modal damping matrix (m, m) from ratios, Rayleigh coefficients or a viscous matrix
     (zero without any); ValueError when it would be negative."""
-    n_modes = omega.size
+    n_modes = lam.size
     if modal_damping is not None:
         z = np.asarray(modal_damping, dtype=float)
         if z.ndim > 1 or (z.ndim == 1 and z.size != n_modes):
             raise ValueError(f"modal_damping must be a number or a list of {n_modes} ratios")
         if np.any(z < 0):
             raise ValueError("modal_damping ratios must be >= 0")
+        omega = np.sqrt(lam)
         Cm = np.diag(2.0 * np.broadcast_to(z, omega.shape) * omega)
     elif rayleigh is not None:
         a = np.asarray(rayleigh, dtype=float)
