@@ -81,12 +81,14 @@ def test_condensed_frf_has_the_full_verdicts_and_jumps(full_path):
 
 def test_walk_with_skips_finds_the_duffing_chain_verdicts(monkeypatch):
     """The walk against every point's spectrum on the continuation's own points.  The points
-    placed on peaks and between long steps are left out here: one of them (0.0803 Hz) is a
+    placed on peaks, between long steps and at bends are left out here: one of them (0.0803 Hz) is a
     one-point unstable island, narrower than the skip, which a walk may miss by design."""
+    import hbm.analyses.curve_bends
     import hbm.analyses.curve_fill
     import hbm.analyses.peak_refine
     from hbm.analyses.stability import StabilityOptions
     monkeypatch.setattr(hbm.analyses.curve_fill, "MAX_SHARE", 10.0)
+    monkeypatch.setattr(hbm.analyses.curve_bends, "ROUNDS", 0)
     monkeypatch.setattr(hbm.analyses.peak_refine, "ROUNDS", 0)
     every = frf(duffing_chain("full"))
     assert every.settings["stability_spectra"] == every.freq_hz.size     # default: every point

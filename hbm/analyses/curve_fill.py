@@ -6,9 +6,12 @@ modes drawn as a V of two chords.  Wherever two consecutive points of one traced
 more than ``MAX_SHARE`` of the window apart in frequency (and the frequency is monotone
 between them), points are solved at evenly spaced frequencies in between by Newton at fixed
 frequency, each started from the linear interpolation of its neighbours' coefficients, and
-inserted in path order.  A solve that fails, or lands farther from its guess than
-``BRANCH_SHARE`` of the step (on another branch that coexists at that frequency, between
-two folds), inserts nothing (the chord stays).
+inserted in path order.  A solve that fails inserts nothing.  When one lands farther from its
+guess than ``BRANCH_SHARE`` of the step, the path bulges away from the chord there (a
+feature the step jumped over) or the solve found another branch coexisting at that
+frequency: the chord is then traced again by continuation in ``n + 1`` steps
+(:func:`hbm.analyses.curve_bends.retrace_chord`), whose points are kept only when the trace
+arrives at the chord's end, i.e. lie on the same branch.
 """
 from __future__ import annotations
 
@@ -18,6 +21,7 @@ import numpy as np
 
 from hbm.balance.energy import energy_balance
 from hbm.balance.newton import newton
+from hbm.analyses.curve_bends import retrace_chord
 
 MAX_SHARE = 1.0 / 60.0
 BRANCH_SHARE = 0.5      # a solved point farther than this share of the step from its guess is refused
@@ -47,14 +51,14 @@ def insert_point(problem, pts, segments, k, at, X, w, its, Y) -> None:
         seg[1] += 1
 
 
-def fill_long_steps(problem, pts, segments, outputs_of, window, xscale, r_scale) -> int:
+def fill_long_steps(problem, case, pts, segments, outputs_of, window, xscale, r_scale) -> int:
     """Insert points so that no step inside a segment spans more than ``MAX_SHARE`` of the
     window (module doc); returns how many were inserted.
 
     Parameters
     ----------
-    problem
-        The FRF's problem.
+    problem, case
+        The FRF's problem and case.
     pts : hbm.analyses.trace._Path
         Traced points, changed in place.
     segments : list of [int, int]
@@ -76,17 +80,31 @@ def fill_long_steps(problem, pts, segments, outputs_of, window, xscale, r_scale)
             if n_new <= 0:
                 i += 1
                 continue
-            X0, X1 = pts.X[i], pts.X[i + 1]
-            radius = BRANCH_SHARE * np.linalg.norm(X1 - X0)
-            new = []
-            for j in range(1, n_new + 1):
-                t = j / (n_new + 1)
-                w = w0 + t * (w1 - w0)
-                got = solve_near(problem, (1 - t) * X0 + t * X1, w, radius, xscale, r_scale)
-                if got is not None:
-                    new.append((got[0], w, got[1]))
-            for off, (X, w, its) in enumerate(new, start=1):
-                insert_point(problem, pts, segments, k, i + off, X, w, its, outputs_of(X, w))
-            added += len(new)
-            i += len(new) + 1
+            new = _solved_between(problem, pts.X[i], pts.X[i + 1], w0, w1, n_new, xscale, r_scale)
+            if new is None:         # the path bulges away from the chord: traced again
+                n = retrace_chord(problem, case, pts, segments, k, i, n_new + 1, xscale, r_scale)
+            else:
+                for off, (X, w, its) in enumerate(new, start=1):
+                    insert_point(problem, pts, segments, k, i + off, X, w, its, outputs_of(X, w))
+                n = len(new)
+            added += n
+            i += n + 1
     return added
+
+
+def _solved_between(problem, X0, X1, w0, w1, n_new, xscale, r_scale):
+    """``n_new`` points ``(X, w, iterations)`` solved at even frequencies strictly between
+    ``w0`` and ``w1``, each from the chord's interpolation; None when one lands farther than
+    ``BRANCH_SHARE`` of the chord from its guess.  A point whose Newton fails is left out."""
+    radius = BRANCH_SHARE * np.linalg.norm(X1 - X0)
+    new = []
+    for j in range(1, n_new + 1):
+        t = j / (n_new + 1)
+        w = w0 + t * (w1 - w0)
+        got = solve_near(problem, (1 - t) * X0 + t * X1, w, math.inf, xscale, r_scale)
+        if got is None:
+            continue
+        if np.linalg.norm(got[0] - ((1 - t) * X0 + t * X1)) > radius:
+            return None
+        new.append((got[0], w, got[1]))
+    return new

@@ -12,10 +12,12 @@ point :math:`i` and its neighbours, in Newton form
 
 with :math:`d_1` the first and :math:`c < 0` the second divided difference, has its vertex at
 :math:`w^* = (w_{i-1} + w_i)/2 - d_1 / (2c)`; the balance is solved
-there by Newton at fixed frequency from :math:`X_i` and the point is inserted in path order.
-This repeats (at most ``ROUNDS`` times per peak) until the vertex moves the amplitude by less
-than ``AMPLITUDE_TOL``.  A solve that fails, or lands off the branch (amplitude below both
-neighbours), inserts nothing.
+there by Newton at fixed frequency from :math:`X_i` and the point is inserted in path order
+(also when it is lower than point :math:`i`, as on a skewed peak: it narrows the bracket for
+the next parabola).  This repeats (at most ``ROUNDS`` times per peak) until the vertex moves
+the amplitude by less than ``AMPLITUDE_TOL`` and the frequency by less than
+``FREQUENCY_TOL``, relative.  A solve that fails, or lands off the branch (amplitude below
+the neighbour on its side), inserts nothing.
 """
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ from hbm.analyses.curve_fill import insert_point, solve_near
 
 ROUNDS = 3
 AMPLITUDE_TOL = 1e-5
+FREQUENCY_TOL = 1e-6
 PROMINENCE = 0.1
 
 
@@ -100,12 +103,12 @@ def refine_peaks(problem, pts, segments, outputs_of, amplitudes, xscale, r_scale
                 X, its = got
                 Y = outputs_of(X, ws)
                 h1 = amplitudes(Y)[o]
-                if h1 < max(a[i - 1], a[i + 1]) or abs(h1 - a[i]) <= AMPLITUDE_TOL * a[i]:
-                    continue
-                insert_point(problem, pts, segments, k, i if (ws - w[i]) * (w[i + 1] - w[i]) < 0 else i + 1,
-                             X, ws, its, Y)
+                after = (ws - w[i]) * (w[i + 1] - w[i]) > 0     # between points i and i + 1
+                if h1 < a[i + 1 if after else i - 1] or abs(ws - w[i]) <= 1e-12 * abs(w[i]):
+                    continue                                    # off the branch, or no new point
+                insert_point(problem, pts, segments, k, i + 1 if after else i, X, ws, its, Y)
                 added += 1
-                moved = True
+                moved = moved or abs(h1 - a[i]) > AMPLITUDE_TOL * a[i] or abs(ws - w[i]) > FREQUENCY_TOL * w[i]
             if not moved:
                 break
     return added

@@ -24,6 +24,7 @@ from hbm.balance.element_outputs import element_output_series
 from hbm.timedomain.floquet_check import confirm_unstable
 from hbm.balance.fourier import FourierBasis, max_abs
 from hbm.analyses.jumps import predict_jumps
+from hbm.analyses.curve_bends import fill_bends
 from hbm.analyses.curve_fill import fill_long_steps
 from hbm.analyses.peak_refine import refine_peaks
 from hbm.analyses.problem_setup import (_first_point, _residual_scale, check_bounded,  # noqa: F401
@@ -141,13 +142,15 @@ def _add_points(problem, case, pts, segments, window, xscale, r_scale, settings)
     rad/s) and next to its peaks; their counts go to ``settings``."""
     outputs_of = lambda X, w: recover_outputs(problem, case, X, w)      # noqa: E731
     if len(pts.w) >= 2:
-        settings["fill_points_added"] = fill_long_steps(problem, pts, segments, outputs_of, window,
+        settings["fill_points_added"] = fill_long_steps(problem, case, pts, segments, outputs_of, window,
                                                         xscale, r_scale)
     basis = problem.basis
     if len(pts.w) >= 3 and 1 in basis.harmonics:
         rc = basis.row_of(1, "c")
-        settings["peak_points_added"] = refine_peaks(problem, pts, segments, outputs_of,
-                                                     lambda Y: np.hypot(Y[rc], Y[rc + 1]), xscale, r_scale)
+        h1 = lambda Y: np.hypot(Y[rc], Y[rc + 1])      # noqa: E731
+        settings["bend_points_added"] = fill_bends(problem, case, pts, segments, h1, xscale, r_scale,
+                                                   budget=max(50, len(pts.w)))
+        settings["peak_points_added"] = refine_peaks(problem, pts, segments, outputs_of, h1, xscale, r_scale)
 
 
 STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
