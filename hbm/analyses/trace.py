@@ -4,7 +4,9 @@ that leave it.
 :func:`trace_window` solves a first point at ``fmin`` (:func:`hbm.analyses.problem_setup._first_point`),
 traces the branch upwards by :class:`continuation.Arclength` (:func:`_trace`: every point's
 energy balance checked, loose ones polished), restarts past a stop the corrector cannot
-pass (:func:`_restart_past_stops`, every skipped stretch stated), and traces from ``fmax``
+pass (:func:`_restart_past_stops`, every skipped stretch stated; a fresh point from the
+linear responses or, failing them, from a time integration's periodic response,
+:mod:`hbm.analyses.td_start`), and traces from ``fmax``
 down what a branch folding back out at ``fmin`` leaves.  When no first point converges at
 ``fmin`` (a stiff contact in stick-slip there, where Newton, the force ramp and its
 arclength version all fail), the window is traced from ``fmax`` down instead, and the
@@ -20,6 +22,7 @@ from hbm.analyses.problem_setup import _first_point, recover_outputs
 from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
 from hbm.balance.energy import energy_balance
 from hbm.balance.newton import newton
+from hbm.analyses.td_start import time_domain_start
 
 POLISH_ENERGY = 1e-10
 # a point whose energy balance stays looser than this after polishing is not a solution
@@ -149,6 +152,7 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
 
 GAP_FIRST = 1e-3        # first restart this share of the window past a stop, doubled per try
 GAP_TRIES = 8
+TD_TRIES, TD_EVERY = 2, 3      # time-domain starts past a stop: at 1 and 8 times GAP_FIRST
 MAX_GAPS = 10
 
 
@@ -168,22 +172,12 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
     gaps = []
     while (status == "failed" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9) and len(gaps) < MAX_GAPS
            and len(pts.w) < case.analysis.max_points):
-        w_from, restart = pts.w[-1], None
-        for k in range(GAP_TRIES):
-            w_r = min(w_from + GAP_FIRST * 2 ** k * (w_hi - w_lo), w_hi)
-            try:
-                Xr, itr = _first_point(problem, case, w_r, xscale, r_scale, arclength_ramp=False)
-            except RuntimeError:
-                if w_r == w_hi:
-                    break
-                continue
-            if energy_balance(problem, Xr, w_r).relative_error <= ENERGY_LIMIT:
-                restart = (Xr, itr, w_r)
-                break
-            if w_r == w_hi:
-                break
-        if restart is None:
-            message += "; no restart past it converged"
+        w_from = pts.w[-1]
+        restart = _fresh_point_past(problem, case, w_from, window, xscale, r_scale)
+        if isinstance(restart, str):
+            w_end = min(w_from + GAP_FIRST * 2 ** (GAP_TRIES - 1) * (w_hi - w_lo), w_hi)
+            message += (f"; no restart past it converged up to {w_end / (2 * np.pi):.6g} Hz ({restart}): "
+                        f"there may be no periodic response (hbm timesim shows the motion)")
             break
         start = len(pts.w)
         # back from the restart towards the stop, so that only what neither side reaches is a gap
@@ -204,6 +198,32 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
         settings["gap_warning"] = (f"the continuation stopped {len(gaps)} time(s) and was restarted further on; "
                                    f"not traced: {where} (first stop: {gaps[0]['reason']})")
     return status, message, folds, n_rej
+
+
+def _fresh_point_past(problem, case, w_from, window, xscale, r_scale):
+    """``(X, iterations, w)`` solved a little past a stop at ``w_from``: Newton from the linear
+    responses at ``GAP_FIRST`` of the window past it, doubled up to ``GAP_TRIES`` times; failing
+    all, from a time integration's periodic response at the first and every ``TD_EVERY``-th
+    of those frequencies, ``TD_TRIES`` at most (:mod:`hbm.analyses.td_start`, small full
+    models).  When nothing converges with a closed energy balance: why the time-domain start
+    failed (str)."""
+    w_lo, w_hi = window
+    ladder = sorted({min(w_from + GAP_FIRST * 2 ** k * (w_hi - w_lo), w_hi) for k in range(GAP_TRIES)})
+    starts = [(w_r, lambda w_r: _first_point(problem, case, w_r, xscale, r_scale, arclength_ramp=False))
+              for w_r in ladder]
+    starts += [(w_r, lambda w_r: time_domain_start(problem, case, w_r, xscale, r_scale))
+               for w_r in ladder[:TD_TRIES * TD_EVERY:TD_EVERY]]
+    why = "no time-domain start (a condensed or large model)"
+    for k, (w_r, solve) in enumerate(starts):
+        try:
+            Xr, itr = solve(w_r)
+        except RuntimeError as exc:
+            if k >= len(ladder):
+                why = str(exc)
+            continue
+        if energy_balance(problem, Xr, w_r).relative_error <= ENERGY_LIMIT:
+            return Xr, itr, w_r
+    return why
 
 
 def trace_window(problem, case, window, xscale, r_scale, opts, progress, settings):
