@@ -24,7 +24,17 @@ def both_paths(el, basis, X, w):
     F = fused.forces(X, w)
     assert np.abs(F - b[0]).max() <= 1e-11 * max(np.abs(b[0]).max(), 1e-300)
     assert np.abs(generic.forces(X, w) - b[0]).max() <= 1e-11 * max(np.abs(b[0]).max(), 1e-300)
+    same_samples(fused, generic, X, w)
     return a, b
+
+
+def same_samples(fused, generic, X, w):
+    """The sampled element forces (element outputs, stuck count) from the compiled AFT equal
+    the element's own march (the generic path)."""
+    for (z1, f1), (z2, f2) in zip(fused.element_forces(X, w), generic.element_forces(X, w)):
+        assert np.array_equal(z1.shape, z2.shape) and f1.shape == f2.shape
+        assert np.abs(z1 - z2).max() <= 1e-12 * max(np.abs(z2).max(), 1e-300)
+        assert np.abs(f1 - f2).max() <= 1e-11 * max(np.abs(f2).max(), 1e-300)
 
 
 def assert_same(a, b, rtol=1e-11):
@@ -96,6 +106,7 @@ def test_wedge_contacts_fused_equal_generic(rng):
     assert len(fused._parts[0]) == 2
     Xn = X[:, fused.dofs]
     assert_same(fused.evaluate(Xn, 50.0), generic.evaluate(Xn, 50.0))
+    same_samples(fused, generic, Xn, 50.0)
 
 
 def run_kernel(el, b, X, w=1.0):

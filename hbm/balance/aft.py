@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hbm.balance.aft_kernel import aft_law
+from hbm.balance.aft_kernel import aft_law, law_samples
 from hbm.balance.fourier import FourierBasis
 from elements.jenkins_events import row_kinds
 
@@ -77,11 +77,12 @@ class NonlinearForces:
         self._seed_v = {}
         # compiled path: (G rows of the law, LawSpec) per law part, or None for a generic element
         compiled = getattr(transform, "name", "") == "dft"
-        self._parts = []
+        self._parts, self._part_rows = [], []
         for e, G in zip(self.elements, self._G):
             parts = e.law_parts() if compiled and e.aft == "sampled" else None
             self._parts.append(None if parts is None else
                                [(np.ascontiguousarray(G[rows]), spec) for rows, spec in parts])
+            self._part_rows.append(None if parts is None else [np.asarray(rows, dtype=int) for rows, _ in parts])
         rows0 = np.flatnonzero(basis.h_of_row == 0)
         self._row0 = int(rows0[0]) if rows0.size else -1
         self._E = np.ascontiguousarray(basis.E)
@@ -212,7 +213,11 @@ class NonlinearForces:
         out = []
         for i, e in enumerate(self.elements):
             z = self.element_samples(Xnl, w, i)
-            dz = np.zeros(z.shape + (1,))
-            f, _ = e.march(z, dz)
+            if self._parts[i] is None:
+                f, _ = e.march(z, np.zeros(z.shape + (1,)))
+            else:           # the law parts' own compiled AFT: no march compiled apart
+                f = np.zeros((z.shape[0], e.n_local))
+                for (Gp, sp), rows in zip(self._parts[i], self._part_rows[i]):
+                    f[:, rows] = law_samples(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0)
             out.append((z, f))
         return out

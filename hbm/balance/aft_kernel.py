@@ -205,7 +205,8 @@ def aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds):
 def make_aft_law(kind, closure):
     """The three steps (inputs, march, analysis + gather) compiled for one law and closure:
     ``run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds, G, X, w, E, dE, P,
-    row0, F, J4, dFdw) -> passes`` (arguments as :func:`aft_law`).
+    row0, F, J4, dFdw, f_out) -> passes`` (arguments as :func:`aft_law`; ``f_out`` (N, n_l)
+    receives the sampled forces ``f``, or has no rows).
 
     ``kind`` and ``closure`` are constants of the compiled function (ints in its closure cells,
     which numba's cache keys by value): numba prunes the other laws and the other closure
@@ -217,17 +218,27 @@ def make_aft_law(kind, closure):
 
     @nb.njit(cache=True)
     def run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
-            G, X, w, E, dE, P, row0, F, J4, dFdw):
+            G, X, w, E, dE, P, row0, F, J4, dFdw, f_out):
         U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
                                                     G, X, w, E, dE)
         if linear:
             aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
+            if f_out.shape[0]:
+                for j in range(z.shape[0]):
+                    for a in range(K.shape[0]):
+                        f_out[j, a] = f0[a]
+                        for b in range(K.shape[1]):
+                            f_out[j, a] += K[a, b] * z[j, b]
             return 0
         if newton:
             f, df, passes = newton_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
         else:
             f, df, passes = march_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
         aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
+        if f_out.shape[0]:      # loops: a slice copy compiles numba's shape-error machinery
+            for j in range(f.shape[0]):
+                for a in range(f.shape[1]):
+                    f_out[j, a] = f[j, a]
         return passes
 
     return run
@@ -236,6 +247,7 @@ def make_aft_law(kind, closure):
 # not touched without seeds; strided like a Jacobian inside a bordered matrix (as the seeded
 # calls pass it), so that each law's kernel is compiled for one layout only
 _NO_J4 = np.zeros((1, 1, 2, 2))[:, :, :, :1]
+_NO_F = np.zeros((0, 0))
 
 
 @functools.cache
@@ -272,7 +284,19 @@ def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
     if J4 is None:
         return aft_of(spec.kind, spec.closure)(
             spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
-            spec.tol, False, G, X, w, E, dE, P, row0, F, _NO_J4, F)
+            spec.tol, False, G, X, w, E, dE, P, row0, F, _NO_J4, F, _NO_F)
     return aft_of(spec.kind, spec.closure)(
         spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
-        spec.tol, True, G, X, w, E, dE, P, row0, F, J4, dFdw)
+        spec.tol, True, G, X, w, E, dE, P, row0, F, J4, dFdw, _NO_F)
+
+
+def law_samples(spec, G, X, w, E, dE, P, row0):
+    """The sampled forces ``f`` (N, n_l) of one law over the period (arguments as
+    :func:`aft_law`), from the same compiled function: the element outputs and the stuck-contact
+    count need no march compiled apart (it doubled the first run's compile time)."""
+    f = np.zeros((E.shape[0], G.shape[0]))
+    F = np.zeros((E.shape[1], X.shape[1]))
+    aft_of(spec.kind, spec.closure)(
+        spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
+        spec.tol, False, G, X, w, E, dE, P, row0, F, _NO_J4, F, f)
+    return f
