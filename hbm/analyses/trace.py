@@ -221,8 +221,11 @@ def _fresh_point_past(problem, case, w_from, window, xscale, r_scale):
             if k >= len(ladder):
                 why = str(exc)
             continue
-        if energy_balance(problem, Xr, w_r).relative_error <= ENERGY_LIMIT:
+        err = energy_balance(problem, Xr, w_r).relative_error
+        if err <= ENERGY_LIMIT:
             return Xr, itr, w_r
+        if k >= len(ladder):
+            why = f"the time-domain start's energy balance did not close ({err:.1e})"
     return why
 
 
