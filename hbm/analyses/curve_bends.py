@@ -33,6 +33,8 @@ import numpy as np
 
 from continuation import ArclengthOptions
 
+from hbm.analyses.trace import _Path, _trace
+
 CURVE_TOL = 5e-3        # largest distance of a chord from the path, in (ln f, ln a): 0.5 %
 FLAG_SHARE = 0.25       # a chord is re-traced when its estimated sag exceeds this share of it
 MAX_SPLIT = 8           # most steps one re-trace divides a chord into
@@ -89,7 +91,6 @@ def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xs
     xscale : ndarray, shape (n_unknowns,)
     r_scale : float
     """
-    from hbm.analyses.trace import _Path, _trace
     w0, w1 = pts.w[i], pts.w[i + 1]
     if w1 == w0:
         return 0
