@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hbm.balance.aft_kernel import aft_law, law_samples
+from hbm.balance.aft_kernel import aft_law, law_samples, touched
 from hbm.balance.fourier import FourierBasis
 from elements.jenkins_events import row_kinds
 
@@ -75,13 +75,14 @@ class NonlinearForces:
         self._G = [np.ascontiguousarray(e.gather[:, self.dofs]) for e in self.elements]
         self._seed_u = {}
         self._seed_v = {}
-        # compiled path: (G rows of the law, LawSpec) per law part, or None for a generic element
+        # compiled path: (G columns the law touches, their indices, LawSpec) per law part
+        # (aft_kernel.touched), or None for a generic element
         compiled = getattr(transform, "name", "") == "dft"
         self._parts, self._part_rows = [], []
         for e, G in zip(self.elements, self._G):
             parts = e.law_parts() if compiled and e.aft == "sampled" else None
             self._parts.append(None if parts is None else
-                               [(np.ascontiguousarray(G[rows]), spec) for rows, spec in parts])
+                               [touched(np.ascontiguousarray(G[rows])) + (spec,) for rows, spec in parts])
             self._part_rows.append(None if parts is None else [np.asarray(rows, dtype=int) for rows, _ in parts])
         rows0 = np.flatnonzero(basis.h_of_row == 0)
         self._row0 = int(rows0[0]) if rows0.size else -1
@@ -152,8 +153,9 @@ class NonlinearForces:
         unclosed = 0
         for e, G, parts in zip(self.elements, self._G, self._parts):
             if parts is not None:
-                for Gp, sp in parts:
-                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw) < 0
+                for Gp, cols, sp in parts:
+                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw,
+                                        cols) < 0
                 continue
             nl = e.n_local
             U = Xnl @ G.T
@@ -194,8 +196,8 @@ class NonlinearForces:
         unclosed = 0
         for i, parts in enumerate(self._parts):
             if parts is not None:
-                for Gp, sp in parts:
-                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F) < 0
+                for Gp, cols, sp in parts:
+                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, cols=cols) < 0
                 continue
             e = self.elements[i]
             exact = self._exact(e, Xnl @ self._G[i].T)
@@ -217,7 +219,7 @@ class NonlinearForces:
                 f, _ = e.march(z, np.zeros(z.shape + (1,)))
             else:           # the law parts' own compiled AFT: no march compiled apart
                 f = np.zeros((z.shape[0], e.n_local))
-                for (Gp, sp), rows in zip(self._parts[i], self._part_rows[i]):
-                    f[:, rows] = law_samples(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0)
+                for (Gp, cols, sp), rows in zip(self._parts[i], self._part_rows[i]):
+                    f[:, rows] = law_samples(sp, Gp, cols, Xnl, w, self._E, self._dE, self._P, self._row0)
             out.append((z, f))
         return out

@@ -38,7 +38,7 @@ from elements.law_march import CLOSE_NEWTON, linear_shortcut, start_sample
 
 
 @nb.njit(cache=True)
-def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
+def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, cols, X, w, E, dE):
     """Coordinates, march inputs and seeds of one law, or its linear shortcut.
 
     Parameters
@@ -47,7 +47,12 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
         The law (:class:`elements.base.LawSpec`).
     seeds : bool
         Seed the march with ``dz/dU`` (and ``dz/dw``); False: no seeds (forces only).
-    G : ndarray, shape (n_l, n_nl)
+    G : ndarray, shape (n_l, n_g)
+        The law's gather on the nonlinear DOFs ``cols`` it touches.
+    cols : ndarray of int, shape (n_g,)
+        Those DOFs' columns in ``X`` (the gather's other columns are zero: a contact of a large
+        patch reads 2 of its hundreds of DOFs, and loops over all of them made its cost grow
+        with the patch).
     X : ndarray, shape (n_coef, n_nl)
         Coefficients of the nonlinear DOFs.
     w : float
@@ -67,16 +72,17 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
     K : ndarray, shape (n_l, n_z)
     f0 : ndarray, shape (n_l,)
     """
-    nc, nn = X.shape
-    nl = G.shape[0]
+    nc = X.shape[0]
+    nl, nn = G.shape
     N = E.shape[0]
     U = np.zeros((nc, nl))
     for a in range(nl):
         for i in range(nn):
             g = G[a, i]
             if g != 0.0:
+                c = cols[i]
                 for k in range(nc):
-                    U[k, a] += X[k, i] * g
+                    U[k, a] += X[k, c] * g
     nz = 2 * nl if velocity else nl
     z = np.zeros((N, nz))
     dth = np.zeros((N, nl))
@@ -118,9 +124,10 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, X, w, E, dE):
 
 
 @nb.njit(cache=True)
-def _gather(G, Fe, dFe, F, J4, dFdw, seeds):
+def _gather(G, cols, Fe, dFe, F, J4, dFdw, seeds):
     """``F += Fe G``; with seeds also ``dFdw += dFe[..., -1] G`` and
-    ``J4[k, :, m, :] += G^T dFe[k, :, m-block] G`` (loops skip the zeros of ``G``)."""
+    ``J4[k, :, m, :] += G^T dFe[k, :, m-block] G``, on the columns ``cols`` of ``G`` (loops
+    skip its zeros)."""
     nc = Fe.shape[0]
     nl, nn = G.shape
     for a in range(nl):
@@ -128,10 +135,11 @@ def _gather(G, Fe, dFe, F, J4, dFdw, seeds):
             g = G[a, i]
             if g == 0.0:
                 continue
+            c = cols[i]
             for k in range(nc):
-                F[k, i] += Fe[k, a] * g
+                F[k, c] += Fe[k, a] * g
                 if seeds:
-                    dFdw[k, i] += dFe[k, a, dFe.shape[2] - 1] * g
+                    dFdw[k, c] += dFe[k, a, dFe.shape[2] - 1] * g
     if not seeds:
         return
     for k in range(nc):
@@ -148,11 +156,11 @@ def _gather(G, Fe, dFe, F, J4, dFdw, seeds):
                         for j in range(nn):
                             gb = G[b, j]
                             if gb != 0.0:
-                                J4[k, i, m, j] += ga * d * gb
+                                J4[k, cols[i], m, cols[j]] += ga * d * gb
 
 
 @nb.njit(cache=True)
-def aft_analyse(P, f, df, G, F, J4, dFdw, seeds):
+def aft_analyse(P, f, df, G, cols, F, J4, dFdw, seeds):
     """Analysis ``P f``, ``P df`` of a marched period and the gather onto the nonlinear DOFs.
 
     Parameters
@@ -160,7 +168,8 @@ def aft_analyse(P, f, df, G, F, J4, dFdw, seeds):
     P : ndarray, shape (n_coef, N)
     f : ndarray, shape (N, n_l)
     df : ndarray, shape (N, n_l, P_s)
-    G : ndarray, shape (n_l, n_nl)
+    G, cols
+        The gather on the DOFs it touches (:func:`aft_inputs`).
     F, dFdw : ndarray, shape (n_coef, n_nl)
         Accumulated in place (``dFdw`` only with seeds).
     J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl)
@@ -175,11 +184,11 @@ def aft_analyse(P, f, df, G, F, J4, dFdw, seeds):
         dFe = (P @ np.ascontiguousarray(df).reshape(N, nl * Ps)).reshape(nc, nl, Ps)
     else:
         dFe = np.zeros((nc, nl, 1))
-    _gather(G, Fe, dFe, F, J4, dFdw, seeds)
+    _gather(G, cols, Fe, dFe, F, J4, dFdw, seeds)
 
 
 @nb.njit(cache=True)
-def aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds):
+def aft_linear(U, K, f0, row0, G, cols, F, J4, dFdw, seeds):
     """Gather of a linear period: ``P f = K U + f0 e_0``, ``d(P f)/dU = K (x) I`` (module doc).
 
     ``row0`` is the row of the mean (harmonic 0), -1 if absent; other arguments as
@@ -199,13 +208,13 @@ def aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds):
                         dFe[k, a, k * nl + b] = kab
         if row0 >= 0:
             Fe[row0, a] += f0[a]
-    _gather(G, Fe, dFe, F, J4, dFdw, seeds)
+    _gather(G, cols, Fe, dFe, F, J4, dFdw, seeds)
 
 
 def make_aft_law(kind, closure):
     """The three steps (inputs, march, analysis + gather) compiled for one law and closure:
-    ``run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds, G, X, w, E, dE, P,
-    row0, F, J4, dFdw, f_out) -> passes`` (arguments as :func:`aft_law`; ``f_out`` (N, n_l)
+    ``run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds, G, cols, X, w, E, dE,
+    P, row0, F, J4, dFdw, f_out) -> passes`` (arguments as :func:`aft_law`; ``f_out`` (N, n_l)
     receives the sampled forces ``f``, or has no rows).
 
     ``kind`` and ``closure`` are constants of the compiled function (ints in its closure cells,
@@ -218,11 +227,11 @@ def make_aft_law(kind, closure):
 
     @nb.njit(cache=True)
     def run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
-            G, X, w, E, dE, P, row0, F, J4, dFdw, f_out):
+            G, cols, X, w, E, dE, P, row0, F, J4, dFdw, f_out):
         U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
-                                                    G, X, w, E, dE)
+                                                    G, cols, X, w, E, dE)
         if linear:
-            aft_linear(U, K, f0, row0, G, F, J4, dFdw, seeds)
+            aft_linear(U, K, f0, row0, G, cols, F, J4, dFdw, seeds)
             if f_out.shape[0]:
                 for j in range(z.shape[0]):
                     for a in range(K.shape[0]):
@@ -234,7 +243,7 @@ def make_aft_law(kind, closure):
             f, df, passes = newton_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
         else:
             f, df, passes = march_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
-        aft_analyse(P, f, df, G, F, J4, dFdw, seeds)
+        aft_analyse(P, f, df, G, cols, F, J4, dFdw, seeds)
         if f_out.shape[0]:      # loops: a slice copy compiles numba's shape-error machinery
             for j in range(f.shape[0]):
                 for a in range(f.shape[1]):
@@ -257,13 +266,22 @@ def aft_of(kind, closure):
     return make_aft_law(kind, closure)
 
 
-def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
+def touched(G: np.ndarray):
+    """``(G_c, cols)``: the columns of ``G`` (n_l, n_nl) that are not all zero, and their
+    indices, the form the kernels take (:func:`aft_inputs`)."""
+    cols = np.flatnonzero(np.any(G != 0.0, axis=0)).astype(np.int64)
+    return np.ascontiguousarray(G[:, cols]), cols
+
+
+def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None, cols=None):
     """Add one law's harmonic forces (and, given ``J4`` and ``dFdw``, exact derivatives).
 
     Parameters
     ----------
     spec : elements.base.LawSpec
-    G : ndarray, shape (n_l, n_nl)
+    G : ndarray, shape (n_l, n_nl), or (n_l, n_g) with ``cols``
+        The law's gather on the nonlinear DOFs; with ``cols``, only its columns ``cols``
+        (:func:`touched`, done once by the caller).
     X : ndarray, shape (n_coef, n_nl)
         Coefficients of the nonlinear DOFs (C-contiguous).
     w : float
@@ -275,28 +293,31 @@ def aft_law(spec, G, X, w, E, dE, P, row0, F, J4=None, dFdw=None):
     J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl), optional
     dFdw : ndarray, shape (n_coef, n_nl), optional
         All accumulated in place.  Without them the march carries no seeds at all.
+    cols : ndarray of int, shape (n_g,), optional
 
     Returns
     -------
     passes : int
         Periods marched (0: linear shortcut; negative: the loop did not close).
     """
+    if cols is None:
+        G, cols = touched(G)
+    run = aft_of(spec.kind, spec.closure)
     if J4 is None:
-        return aft_of(spec.kind, spec.closure)(
-            spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
-            spec.tol, False, G, X, w, E, dE, P, row0, F, _NO_J4, F, _NO_F)
-    return aft_of(spec.kind, spec.closure)(
-        spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
-        spec.tol, True, G, X, w, E, dE, P, row0, F, J4, dFdw, _NO_F)
+        return run(spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
+                   spec.tol, False, G, cols, X, w, E, dE, P, row0, F, _NO_J4, F, _NO_F)
+    return run(spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
+               spec.tol, True, G, cols, X, w, E, dE, P, row0, F, J4, dFdw, _NO_F)
 
 
-def law_samples(spec, G, X, w, E, dE, P, row0):
+def law_samples(spec, G, cols, X, w, E, dE, P, row0):
     """The sampled forces ``f`` (N, n_l) of one law over the period (arguments as
-    :func:`aft_law`), from the same compiled function: the element outputs and the stuck-contact
-    count need no march compiled apart (it doubled the first run's compile time)."""
+    :func:`aft_law`, ``cols`` given), from the same compiled function: the element outputs and
+    the stuck-contact count need no march compiled apart (it doubled the first run's compile
+    time)."""
     f = np.zeros((E.shape[0], G.shape[0]))
     F = np.zeros((E.shape[1], X.shape[1]))
     aft_of(spec.kind, spec.closure)(
         spec.params, spec.n_state, spec.start_rule, spec.n_start, spec.velocity, spec.max_passes,
-        spec.tol, False, G, X, w, E, dE, P, row0, F, _NO_J4, F, f)
+        spec.tol, False, G, cols, X, w, E, dE, P, row0, F, _NO_J4, F, f)
     return f
