@@ -75,7 +75,8 @@ def chord_sags(w: np.ndarray, amps: np.ndarray) -> np.ndarray:
     return sag.max(axis=1)
 
 
-def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xscale, r_scale) -> int:
+def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xscale, r_scale,
+                  progress=None) -> int:
     """Trace chord ``(i, i + 1)`` of segment ``k`` again by continuation in steps of at most
     ``1 / n_steps`` of its scaled length; insert the points in between when the trace arrives
     at point ``i + 1`` (module doc).  Returns how many were inserted (0: it did not arrive).
@@ -90,6 +91,9 @@ def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xs
         ``[start, end)`` of each segment, shifted by the insertion.
     xscale : ndarray, shape (n_unknowns,)
     r_scale : float
+    progress : callable, optional
+        The FRF's ``progress(n_points, freq_hz)``, told of every point of the trace (counted
+        after the path's points).
     """
     w0, w1 = pts.w[i], pts.w[i + 1]
     if w1 == w0:
@@ -100,7 +104,7 @@ def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xs
     opts = ArclengthOptions(ds0=ds, ds_max=ds, max_steps=4 * n_steps)
     sub = _Path()
     _trace(problem, case, sub, pts.X[i], 0, w0, (min(w0, w1), max(w0, w1)), 1 if w1 > w0 else -1,
-           xscale, r_scale, opts, None)
+           xscale, r_scale, opts, progress, offset=len(pts.w) - 1)
     if len(sub.w) < 3 or abs(sub.w[-1] - w1) > 1e-12 * abs(w1) \
             or np.max(np.abs(problem.unknowns(sub.X[-1]) - u1) / xscale) > ARRIVAL:
         return 0
@@ -114,7 +118,7 @@ def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xs
     return n
 
 
-def fill_bends(problem, case, pts, segments, amplitudes, xscale, r_scale, budget: int) -> int:
+def fill_bends(problem, case, pts, segments, amplitudes, xscale, r_scale, budget: int, progress=None) -> int:
     """Re-trace the chords whose estimated sag exceeds ``FLAG_SHARE * CURVE_TOL`` (module doc),
     at most ``budget`` points in all; returns how many were inserted.
 
@@ -122,6 +126,8 @@ def fill_bends(problem, case, pts, segments, amplitudes, xscale, r_scale, budget
     ----------
     amplitudes : callable
         ``Y -> h1`` (n_o,), the first-harmonic amplitudes of a point's outputs.
+    progress : callable, optional
+        As :func:`retrace_chord`'s.
     """
     added = 0
     for _ in range(ROUNDS):
@@ -138,7 +144,7 @@ def fill_bends(problem, case, pts, segments, amplitudes, xscale, r_scale, budget
             if added + round_added >= budget:
                 break
             n = min(MAX_SPLIT, max(2, math.ceil(2.0 * math.sqrt(sg / CURVE_TOL))))
-            round_added += retrace_chord(problem, case, pts, segments, k, i, n, xscale, r_scale)
+            round_added += retrace_chord(problem, case, pts, segments, k, i, n, xscale, r_scale, progress)
         added += round_added
         if round_added == 0 or added >= budget:
             break

@@ -51,7 +51,7 @@ def insert_point(problem, pts, segments, k, at, X, w, its, Y) -> None:
         seg[1] += 1
 
 
-def fill_long_steps(problem, case, pts, segments, outputs_of, window, xscale, r_scale) -> int:
+def fill_long_steps(problem, case, pts, segments, outputs_of, window, xscale, r_scale, progress=None) -> int:
     """Insert points so that no step inside a segment spans more than ``MAX_SHARE`` of the
     window (module doc); returns how many were inserted.
 
@@ -69,6 +69,8 @@ def fill_long_steps(problem, case, pts, segments, outputs_of, window, xscale, r_
         ``(w_lo, w_hi)``, rad/s.
     xscale : ndarray
     r_scale : float
+    progress : callable, optional
+        The FRF's, told of the points of a chord traced again.
     """
     limit = MAX_SHARE * (window[1] - window[0])
     added = 0
@@ -82,7 +84,7 @@ def fill_long_steps(problem, case, pts, segments, outputs_of, window, xscale, r_
                 continue
             new = _solved_between(problem, pts.X[i], pts.X[i + 1], w0, w1, n_new, xscale, r_scale)
             if new is None:         # the path bulges away from the chord: traced again
-                n = retrace_chord(problem, case, pts, segments, k, i, n_new + 1, xscale, r_scale)
+                n = retrace_chord(problem, case, pts, segments, k, i, n_new + 1, xscale, r_scale, progress)
             else:
                 for off, (X, w, its) in enumerate(new, start=1):
                     insert_point(problem, pts, segments, k, i + off, X, w, its, outputs_of(X, w))

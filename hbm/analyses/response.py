@@ -110,7 +110,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         hint = stiff_contact_hint(case)
         if hint:
             settings["contact_hint"] = hint
-    _add_points(problem, case, pts, segments, (w_lo, w_hi), xscale, r_scale, settings)
+    _add_points(problem, case, pts, segments, (w_lo, w_hi), xscale, r_scale, settings, progress)
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
     _closure_warning(settings, pts.unclosed, pts.w)
@@ -137,19 +137,20 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
                      jumps, eouts, Ys, stuck)
 
 
-def _add_points(problem, case, pts, segments, window, xscale, r_scale, settings) -> None:
+def _add_points(problem, case, pts, segments, window, xscale, r_scale, settings, progress=None) -> None:
     """Points solved into the traced path ``pts`` where its steps are long (over ``window``,
-    rad/s) and next to its peaks; their counts go to ``settings``."""
+    rad/s), where its chords turn and on its peaks; their counts go to ``settings``.  Chords
+    traced again report their points to ``progress``."""
     outputs_of = lambda X, w: recover_outputs(problem, case, X, w)      # noqa: E731
     if len(pts.w) >= 2:
         settings["fill_points_added"] = fill_long_steps(problem, case, pts, segments, outputs_of, window,
-                                                        xscale, r_scale)
+                                                        xscale, r_scale, progress)
     basis = problem.basis
     if len(pts.w) >= 3 and 1 in basis.harmonics:
         rc = basis.row_of(1, "c")
         h1 = lambda Y: np.hypot(Y[rc], Y[rc + 1])      # noqa: E731
         settings["bend_points_added"] = fill_bends(problem, case, pts, segments, h1, xscale, r_scale,
-                                                   budget=max(50, len(pts.w)))
+                                                   budget=max(50, len(pts.w)), progress=progress)
         settings["peak_points_added"] = refine_peaks(problem, pts, segments, outputs_of, h1, xscale, r_scale)
 
 
