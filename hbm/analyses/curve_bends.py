@@ -108,14 +108,7 @@ def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xs
     if len(sub.w) < 3 or abs(sub.w[-1] - w1) > 1e-12 * abs(w1) \
             or np.max(np.abs(problem.unknowns(sub.X[-1]) - u1) / xscale) > ARRIVAL:
         return 0
-    n = len(sub.w) - 2
-    for name in ("X", "w", "Y", "its", "err", "unclosed"):
-        getattr(pts, name)[i + 1:i + 1] = getattr(sub, name)[1:-1]
-    segments[k][1] += n
-    for seg in segments[k + 1:]:
-        seg[0] += n
-        seg[1] += n
-    return n
+    return pts.insert(i + 1, segments, k, sub, 1, len(sub.w) - 1)
 
 
 def fill_bends(problem, case, pts, segments, amplitudes, xscale, r_scale, budget: int, progress=None) -> int:

@@ -22,6 +22,7 @@ import numpy as np
 from hbm.balance.energy import energy_balance
 from hbm.balance.newton import newton
 from hbm.analyses.curve_bends import retrace_chord
+from hbm.analyses.trace import _Path
 
 MAX_SHARE = 1.0 / 60.0
 BRANCH_SHARE = 0.5      # a solved point farther than this share of the step from its guess is refused
@@ -41,14 +42,11 @@ def solve_near(problem, guess, w, radius, xscale, r_scale, tol=1e-10):
 def insert_point(problem, pts, segments, k, at, X, w, its, Y) -> None:
     """Insert the solved point ``(X, w)`` with outputs ``Y`` at path index ``at`` of segment
     ``k`` (its energy error and loop closure taken here); later segments shift by one."""
-    err = energy_balance(problem, X, w).relative_error
-    for name, v in (("X", X), ("w", w), ("Y", Y), ("its", its), ("err", err),
-                    ("unclosed", problem.nl.last_unclosed)):
-        getattr(pts, name).insert(at, v)
-    segments[k][1] += 1
-    for seg in segments[k + 1:]:
-        seg[0] += 1
-        seg[1] += 1
+    one = _Path()
+    for name, v in zip(_Path.FIELDS, (X, w, Y, its, energy_balance(problem, X, w).relative_error,
+                                      problem.nl.last_unclosed)):
+        getattr(one, name).append(v)
+    pts.insert(at, segments, k, one, 0, 1)
 
 
 def fill_long_steps(problem, case, pts, segments, outputs_of, window, xscale, r_scale, progress=None) -> int:

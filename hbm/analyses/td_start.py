@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hbm.balance.fourier import basis_matrix
 from hbm.balance.newton import newton
 
 MAX_DOFS = 200          # larger models: no time-domain start (its cost grows with n^3 per step)
@@ -75,13 +76,4 @@ def time_domain_start(problem, case, w: float, xscale, r_scale):
 def fit_harmonics(basis, w: float, t: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Least-squares coefficients ``X`` (n_coef, n) of ``basis`` at ``w`` for samples ``q``
     (n_t, n) at times ``t`` (n_t,) (module doc)."""
-    th = w * (t - t[0])
-    A = np.empty((t.size, basis.n_coef))
-    for h in basis.harmonics:
-        h = int(h)
-        if h == 0:
-            A[:, basis.row_of(0)] = 1.0
-        else:
-            A[:, basis.row_of(h, "c")] = np.cos(h * th)
-            A[:, basis.row_of(h, "s")] = np.sin(h * th)
-    return np.linalg.lstsq(A, q, rcond=None)[0]
+    return np.linalg.lstsq(basis_matrix(basis.h_of_row, w * (t - t[0])), q, rcond=None)[0]

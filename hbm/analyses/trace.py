@@ -80,14 +80,28 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
 class _Path:
     """Converged points of a traced path: coefficients, frequencies, outputs, iterations, errors."""
 
+    FIELDS = ("X", "w", "Y", "its", "err", "unclosed")
+
     def __init__(self):
         self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
 
     def extend_reversed(self, other: "_Path", skip_first: bool = False) -> None:
         """Append ``other``'s points in reverse order (without its first point if ``skip_first``)."""
         k = 1 if skip_first else 0
-        for name in ("X", "w", "Y", "its", "err", "unclosed"):
+        for name in self.FIELDS:
             getattr(self, name).extend(getattr(other, name)[k:][::-1])
+
+    def insert(self, at: int, segments, k: int, other: "_Path", lo: int, hi: int) -> int:
+        """Insert ``other``'s points ``lo:hi`` before point ``at``, which lies in segment ``k`` of
+        ``segments`` (``[start, end)`` index ranges, shifted here); returns how many."""
+        for name in self.FIELDS:
+            getattr(self, name)[at:at] = getattr(other, name)[lo:hi]
+        n = len(other.w[lo:hi])
+        segments[k][1] += n
+        for seg in segments[k + 1:]:
+            seg[0] += n
+            seg[1] += n
+        return n
 
 
 def _widened_scale(problem, xscale: np.ndarray, X0: np.ndarray) -> np.ndarray:
