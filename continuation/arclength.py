@@ -57,7 +57,7 @@ import numpy as np
 
 from .acceptance import Step, judge_step
 from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
-from .linsolve import REUSE_MIN_SIZE, ReusedLU, direct_solve
+from .linsolve import make_solver
 from .options import ArclengthOptions, default_scale
 from .point import ContinuationPoint
 from .tangent import fold_parameter, null_tangent
@@ -108,6 +108,10 @@ class Arclength:
         LU, two ``n x n`` arrays in all while a step is corrected.
     describe_lam : callable, optional
         ``lam -> str`` naming a parameter value in messages (default ``"lam=<value>"``).
+    blocks : sequence of (int, int), optional
+        ``(start, stop)`` ranges of the unknowns coupled mainly among themselves: large
+        systems then precondition their Newton solves by these diagonal blocks first
+        (:class:`continuation.linsolve.BlockPreconditioned`).
 
     Attributes
     ----------
@@ -130,7 +134,7 @@ class Arclength:
 
     def __init__(self, fun: Fun, x0, scale=None, lam_bounds=(-np.inf, np.inf),
                  direction: int = +1, options: ArclengthOptions | None = None, lam_step=None,
-                 overwrite_jacobian: bool = False, describe_lam=None, fun_into=None):
+                 overwrite_jacobian: bool = False, describe_lam=None, fun_into=None, blocks=None):
         x0 = np.array(x0, dtype=float).ravel()
         if x0.size < 2 or not np.all(np.isfinite(x0)):
             raise ValueError("x0 must be a finite vector [y, lam] with at least one unknown")
@@ -168,7 +172,7 @@ class Arclength:
         self._rho0: float | None = None
         # large systems keep an LU across Newton iterations and steps (continuation.linsolve);
         # callers may solve their own (n+1, n+1) systems with it (a fixed-parameter polish)
-        self.linear_solve = ReusedLU() if x0.size >= REUSE_MIN_SIZE else direct_solve
+        self.linear_solve = make_solver(x0.size, blocks)
 
     # ------------------------------------------------------------------ evaluation
     def _evaluate(self, xs: np.ndarray) -> Evaluation:

@@ -105,13 +105,13 @@ def test_frf_with_the_jacobian_in_the_newton_matrix_equals_the_direct_one(monkey
     large problems; forced onto a 3-DOF case (kept LU and GMRES from 0 unknowns) it finds the
     same response: every point solves the balance and the peaks agree."""
     import hbm
-    import continuation.arclength as arclength
+    import continuation.linsolve as linsolve
     from hbm.analyses.problem_setup import build_problem, resolve_settings
     from hbm.balance.fourier import FourierBasis
     from test_truncation import three_dof
     case = three_dof()
     ref = hbm.frf(case, stability=False, error_estimate=False)
-    monkeypatch.setattr(arclength, "REUSE_MIN_SIZE", 1)
+    monkeypatch.setattr(linsolve, "REUSE_MIN_SIZE", 1)
     got = hbm.frf(case, stability=False, error_estimate=False)
     assert ref.ok and got.ok, (ref.message, got.message)
     a_ref, a_got = ref.outputs["x3"].h1, got.outputs["x3"].h1

@@ -32,7 +32,8 @@ def solve_near(problem, guess, w, radius, xscale, r_scale, tol=1e-10):
     """Newton at fixed ``w`` from ``guess`` (n_coef, n): ``(X, iterations)``, or None when it
     fails or lands farther than ``radius`` from the guess (another branch coexisting at ``w``)."""
     fun = lambda u: problem.residual(problem.expand(u), w)[:2]
-    res = newton(fun, problem.unknowns(guess), scale=xscale, r_scale=r_scale, tol=tol)
+    res = newton(fun, problem.unknowns(guess), scale=xscale, r_scale=r_scale, tol=tol,
+                 blocks=problem.harmonic_blocks())
     if not res.converged:
         return None
     X = problem.expand(res.x)

@@ -189,10 +189,12 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
     the traced ramp cost half the run on the cross beam and found nothing the next try did not).
     """
     fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
+    blocks = problem.harmonic_blocks()
     guesses = [problem.linear_solution(w0, problem.stuck_stiffness()), problem.linear_solution(w0)]
     last = None
     for g in guesses:
-        res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale, overwrite_jacobian=True)
+        res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale, overwrite_jacobian=True,
+                     blocks=blocks)
         if res.converged:
             return problem.expand(res.x), res.iterations
         last = res
@@ -203,7 +205,8 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
         def fun_l(x, lam=lam):
             R, J = fun(x)
             return R - (1.0 - lam) * R0, J
-        res = newton(fun_l, x, scale=scale, r_scale=r_scale, max_iter=60, overwrite_jacobian=True)
+        res = newton(fun_l, x, scale=scale, r_scale=r_scale, max_iter=60, overwrite_jacobian=True,
+                     blocks=blocks)
         its += res.iterations
         if not res.converged:
             break
@@ -211,14 +214,14 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
     else:
         return problem.expand(x), its
     ramp = f"ramp stopped at {lam:.0%} of the excitation: {res.message}"
-    x, its_h, why = _homotopy_path(fun, R0, scale, r_scale) if arclength_ramp else (None, 0, "no arclength ramp")
+    x, its_h, why = _homotopy_path(fun, R0, scale, r_scale, blocks) if arclength_ramp else (None, 0, "no arclength ramp")
     if x is None:
         raise RuntimeError(f"first point at {w0 / (2 * np.pi):.6g} Hz did not converge "
                            f"(linear starts: {last.message}; {ramp}; {why})")
     return problem.expand(x), its + its_h
 
 
-def _homotopy_path(fun, R0, scale, r_scale, max_steps=400):
+def _homotopy_path(fun, R0, scale, r_scale, blocks=None, max_steps=400):
     """Solve ``R(x) = 0`` by tracing ``H(x, lam) = R(x) - (1 - lam) R0`` from ``(0, 0)`` to
     ``lam = 1`` with :class:`continuation.Arclength` (``dH/dlam = R0``), then Newton on ``R``
     from the point on ``lam = 1``.
@@ -238,7 +241,7 @@ def _homotopy_path(fun, R0, scale, r_scale, max_steps=400):
 
     path = Arclength(fun_h, np.zeros(scale.size + 1), scale=np.r_[scale, 1.0], lam_bounds=(-1.0, 1.0),
                      options=ArclengthOptions(max_steps=max_steps, ds0=0.05), overwrite_jacobian=True,
-                     describe_lam=lambda lam: f"{lam:.0%} of the excitation")
+                     describe_lam=lambda lam: f"{lam:.0%} of the excitation", blocks=blocks)
     end = None
     for pt in path:
         end = pt
@@ -246,7 +249,7 @@ def _homotopy_path(fun, R0, scale, r_scale, max_steps=400):
             break
     if end is None or not end.on_bound or end.lam < 1.0:
         return None, path.n_eval, f"arclength ramp: {path.message or 'left at ' + path.status}"
-    res = newton(fun, end.y, scale=scale, r_scale=r_scale)
+    res = newton(fun, end.y, scale=scale, r_scale=r_scale, blocks=blocks)
     if not res.converged:
         return None, path.n_eval + res.iterations, f"arclength ramp reached 100 %, then {res.message}"
     return res.x, path.n_eval + res.iterations, ""

@@ -67,7 +67,8 @@ def time_domain_start(problem, case, w: float, xscale, r_scale):
         raise RuntimeError(f"a time integration from rest found no periodic response in {PERIODS} periods")
     X = fit_harmonics(problem.basis, w, run.history.t, run.history.q)
     fun = lambda u: problem.residual(problem.expand(u), w)[:2]      # noqa: E731
-    res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, overwrite_jacobian=True)
+    res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, overwrite_jacobian=True,
+                 blocks=problem.harmonic_blocks())
     if not res.converged:
         raise RuntimeError(f"Newton from a time integration's periodic response: {res.message}")
     return problem.expand(res.x), res.iterations

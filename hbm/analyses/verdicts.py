@@ -59,7 +59,8 @@ def landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
             t = 0.0 if df == 0 else min(max((f_hz - freq_hz[i0]) / df, 0.0), 1.0)
             X0 = Xs[i0] + t * (Xs[i1] - Xs[i0])
             fun = lambda x: problem.residual(problem.expand(x), w)[:2]
-            res = newton(fun, problem.unknowns(X0), scale=xscale, r_scale=r_scale)
+            res = newton(fun, problem.unknowns(X0), scale=xscale, r_scale=r_scale,
+                         blocks=problem.harmonic_blocks())
             X = problem.expand(res.x) if res.converged else None
             if X is not None and not point_is_stable(problem, X, w, stability_options):
                 X = None

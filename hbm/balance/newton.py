@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from continuation.linsolve import REUSE_MIN_SIZE, ReusedLU, direct_solve
+from continuation.linsolve import make_solver
 
 _EPS = np.finfo(float).eps
 
@@ -55,7 +55,7 @@ def _polished(x, R, J, S, linear_solve, overwrite=False):
 
 
 def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_solve=None,
-           overwrite_jacobian=False) -> NewtonResult:
+           overwrite_jacobian=False, blocks=None) -> NewtonResult:
     """Solve ``fun(x) = (R, J) -> R = 0``.
 
     Parameters
@@ -74,11 +74,14 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
     linear_solve : callable, optional
         ``(A (n, n), B (n, 1)) -> A^{-1} B`` or None when singular (:mod:`continuation.linsolve`;
         pass one :class:`~continuation.linsolve.ReusedLU` to many calls to keep its LU);
-        default: a direct LU, or a kept LU with GMRES for this call's iterations when
-        ``n >= REUSE_MIN_SIZE``.
+        default: :func:`continuation.linsolve.make_solver` of ``n`` and ``blocks`` (a direct LU
+        on small systems, else GMRES on the diagonal ``blocks`` or a kept LU).
     overwrite_jacobian : bool
         ``fun`` returns a new ``J`` on every call, which may be scaled in place (no copy of an
         ``n x n`` matrix per update).
+    blocks : sequence of (int, int), optional
+        ``(start, stop)`` ranges of unknowns coupled mainly among themselves (e.g.
+        :meth:`hbm.balance.residual.HarmonicBalance.harmonic_blocks`).
 
     Returns
     -------
@@ -87,7 +90,7 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
     x = np.array(x0, dtype=float)
     S = np.ones_like(x) if scale is None else np.asarray(scale, dtype=float)
     if linear_solve is None:
-        linear_solve = ReusedLU() if x.size >= REUSE_MIN_SIZE else direct_solve
+        linear_solve = make_solver(x.size, blocks)
     R, J = fun(x)
     r = float(np.linalg.norm(R))
     target = tol * max(r_scale, 1e-300)
