@@ -26,8 +26,8 @@ def test_polish_closes_an_imbalance_the_residual_explains():
     Xp = X * (1 + 1e-6)                                    # a residual of ~1e-6 of the load
     eb = problem.energy_balance(Xp, w)
     calls = counted(problem)
-    Xq, err = _polish(problem, Xp, w, np.full(problem.n_unknowns, 1.0), 1.0, eb)
-    assert len(calls) >= 2
+    Xq, err, floor = _polish(problem, Xp, w, np.full(problem.n_unknowns, 1.0), 1.0, eb)
+    assert len(calls) >= 2 and floor == 0.0
     assert err < 1e-3 * eb.relative_error
     np.testing.assert_allclose(Xq, X, atol=1e-12 * np.abs(X).max())
 
@@ -38,5 +38,6 @@ def test_polish_skips_an_imbalance_the_residual_cannot_explain():
     true = problem.energy_balance(X, w)
     fake = EnergyBalance(true.excitation * (1 + 1e-6), true.viscous, true.nonlinear, true.bound)
     calls = counted(problem)
-    Xq, err = _polish(problem, X, w, np.full(problem.n_unknowns, 1.0), 1.0, fake)
+    Xq, err, floor = _polish(problem, X, w, np.full(problem.n_unknowns, 1.0), 1.0, fake)
     assert len(calls) == 1 and Xq is X and err == fake.relative_error
+    assert floor == 0.0         # a full model's works use the residual's own matrices: no floor

@@ -25,22 +25,27 @@ from hbm.balance.newton import newton
 from hbm.analyses.td_start import time_domain_start
 
 POLISH_ENERGY = 1e-10
-# a point whose energy balance stays looser than this after polishing is not a solution
-# the FRF can report: the path ends before it (status failed, the point named)
+# a point whose energy balance stays looser than this after polishing (and than twice the
+# balance's resolution there, CondensedLinear.work_resolution) is not a solution the FRF can
+# report: the path ends before it (status failed, the point named)
 ENERGY_LIMIT = 1e-8
+
+
 def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
     """Newton at fixed ``w`` on a point whose energy balance ``eb`` is not closed.
 
     The continuation's tolerance is relative to the Jacobian's row norm, which a stiff
     contact (kt >> k) makes large against the excitation: such a point can be accepted with
     ``|R| / |F|`` ~ 1e-9 and an energy error ~ 1e-6.  Here the target is relative to ``|F|``.
-    Returns the better of the two points and its relative energy error.
+    Returns the better of the two points, its relative energy error and the balance's
+    resolution at it in the same measure (0 when not needed).
 
     The imbalance of the works is the work of the residual on the motion,
-    ``pi R . (D X)`` (:mod:`hbm.balance.energy`), plus the works' own round-off.  When the
-    residual's work is below a tenth of the imbalance, no Newton update can close the
-    balance (e.g. 3.7e-9 on a stuck FE contact patch at |R| / |F| = 7e-15): the point is
-    returned as it is, at the cost of one evaluation.
+    ``pi R . (D X)`` (:mod:`hbm.balance.energy`), plus what the linear part's arithmetic leaves
+    (:meth:`hbm.balance.residual.HarmonicBalance.energy_resolution`).  When the residual's work
+    is below a tenth of the imbalance, no Newton update can close the balance (e.g. 1e-8 on a
+    stuck FE contact patch next to a mode its contacts block, at |R| / |F| = 1e-13): the point
+    is returned as it is with that resolution, at the cost of one evaluation.
 
     The update solves the continuation's bordered system with the frequency row fixed,
     ``[J, dR/dw; e_w^T] [dX; dw] = [-R; 0]`` (so ``dw = 0``), with ``linear_solve``: the
@@ -63,8 +68,9 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
     x0 = np.r_[problem.unknowns(X), w]
     first = bordered(x0)
     explained = np.pi * abs(first[0][:-1] @ problem.unknowns(problem.basis.D @ X))
-    if explained < 0.1 * abs(eb.excitation - eb.viscous - eb.nonlinear):
-        return X, err
+    imbalance = abs(eb.excitation - eb.viscous - eb.nonlinear)
+    if explained < 0.1 * imbalance:
+        return X, err, err * problem.energy_resolution(X, w) / imbalance
     calls = iter([first])                     # Newton's first call gets the evaluation at hand
     del first                                 # (its Jacobian is then not held past that call)
     res = newton(lambda u: next(calls, None) or bordered(u), x0, scale=np.r_[xscale, w_scale],
@@ -73,8 +79,8 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
         Xp = problem.expand(res.x[:-1])
         err_p = energy_balance(problem, Xp, w).relative_error
         if err_p < err:
-            return Xp, err_p
-    return X, err
+            return Xp, err_p, 0.0
+    return X, err, 0.0
 
 
 class _Path:
@@ -143,13 +149,13 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
         X = problem.expand(pt.x[:-1])
         w = float(pt.x[-1])
         eb = energy_balance(problem, X, w)
-        err = eb.relative_error
+        err, floor = eb.relative_error, 0.0
         if err > POLISH_ENERGY:
-            X, err = _polish(problem, X, w, xscale, r_scale, eb, solver.linear_solve, scale[-1])
-        if err > ENERGY_LIMIT:
+            X, err, floor = _polish(problem, X, w, xscale, r_scale, eb, solver.linear_solve, scale[-1])
+        if err > ENERGY_LIMIT + 2 * floor:
             return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
                     f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "
-                    f"after polishing); the {len(pts.w)} points before it are kept",
+                    f"after polishing, resolution there {floor:.1e}); the {len(pts.w)} points before it are kept",
                     [f / (2 * np.pi) for f in solver.folds], solver.n_rejected)
         pts.X.append(X)
         pts.w.append(w)

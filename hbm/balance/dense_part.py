@@ -165,6 +165,11 @@ class DenseLinear:
         R[:] = (ZX - self.Fex + Fn).reshape(-1)[fi]
         dRw[:] = (dZX + dFw).reshape(-1)[fi]
 
+    def work_resolution(self, X: np.ndarray, w: float) -> float:
+        """0: :meth:`work` uses the residual's own matrices, so only round-off separates them
+        (compare :meth:`hbm.balance.condensed.CondensedLinear.work_resolution`)."""
+        return 0.0
+
     def work(self, X: np.ndarray, w: float, Fn: np.ndarray):
         """Excitation and viscous work per period and the bound ``S`` (:mod:`hbm.balance.energy`).
 

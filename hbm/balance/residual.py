@@ -199,6 +199,12 @@ class HarmonicBalance:
         w_ex, w_visc, bound = self.linear.work(X, w, Fn)
         return EnergyBalance(w_ex, w_visc, work(self.basis, Fn, w * (self.basis.D @ X), w), bound)
 
+    def energy_resolution(self, X: np.ndarray, w: float) -> float:
+        """Energy imbalance (J per period) the linear part's own arithmetic can leave at an
+        exact solution (``linear.work_resolution``): below it the balance cannot tell a
+        solution from a non-solution."""
+        return self.linear.work_resolution(X, w)
+
     def recover_outputs(self, X: np.ndarray, w: float) -> np.ndarray:
         """Output coefficients (n_coef, n_o) of a point ``X`` (n_coef, n)."""
         return self.linear.recover_outputs(X, w)
