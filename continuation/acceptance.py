@@ -58,7 +58,7 @@ class Step(NamedTuple):
 
 
 def judge_step(c: Correction, xs, t, start, ds: float, sphere: bool, on_bound: bool, options,
-               angle_reject, ds_min: float) -> Step:
+               angle_reject, ds_min: float, linear_solve=None) -> Step:
     """Decide a converged correction ``c`` of the step from ``xs`` (module doc).
 
     Parameters
@@ -75,6 +75,8 @@ def judge_step(c: Correction, xs, t, start, ds: float, sphere: bool, on_bound: b
     angle_reject : tuple (ds, angle) or None
         The last step refused for its turn.
     ds_min : float
+    linear_solve : callable, optional
+        The path's iterative solver, for the new tangent (:func:`continuation.tangent.null_tangent`).
 
     Returns
     -------
@@ -95,7 +97,7 @@ def judge_step(c: Correction, xs, t, start, ds: float, sphere: bool, on_bound: b
     if fast:
         t_new = c.null * f
     else:
-        u = null_tangent(c.ev.Js, t, c.matrix, c.ev.row_norm())     # consumes c.ev.Js
+        u = null_tangent(c.ev.Js, t, c.matrix, c.ev.row_norm(), linear_solve)     # consumes c.ev.Js
         if u is None:
             return Step(c, None, 0.0, "the tangent system is singular", on_bound)
         _, _, _, cosang, f = step_geometry(xs, t, c.xs, start, u)

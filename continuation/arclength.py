@@ -57,7 +57,7 @@ import numpy as np
 
 from .acceptance import Step, judge_step
 from .corrector import Correction, Evaluation, correct, linear_constraint, sphere_constraint
-from .linsolve import make_solver
+from .linsolve import direct_solve, make_solver
 from .options import ArclengthOptions, default_scale
 from .point import ContinuationPoint
 from .tangent import fold_parameter, null_tangent
@@ -173,6 +173,9 @@ class Arclength:
         # large systems keep an LU across Newton iterations and steps (continuation.linsolve);
         # callers may solve their own (n+1, n+1) systems with it (a fixed-parameter polish)
         self.linear_solve = make_solver(x0.size, blocks)
+        # the tangent's bordered system on the same solver when it is iterative (a direct
+        # one factors the matrix in place, null_tangent's own way)
+        self._tangent_solve = None if self.linear_solve is direct_solve else self.linear_solve
 
     # ------------------------------------------------------------------ evaluation
     def _evaluate(self, xs: np.ndarray) -> Evaluation:
@@ -313,7 +316,7 @@ class Arclength:
             return None, None
         e = np.zeros_like(xs)
         e[-1] = self.direction
-        t = null_tangent(c.ev.Js, e, c.matrix, c.ev.row_norm())
+        t = null_tangent(c.ev.Js, e, c.matrix, c.ev.row_norm(), self._tangent_solve)
         if t is None:
             self._fail(f"the path's tangent at the starting point {self._lam(self.x0[-1])} is "
                        f"undefined (singular bordered system)")
@@ -391,7 +394,8 @@ class Arclength:
                 on_bound = True
         if not c.converged:
             return Step(c, None, 0.0, f"Newton did not converge ({c.reason})", on_bound)
-        return judge_step(c, xs, t, start, ds, sphere, on_bound, o, angle_reject, self.ds_min)
+        return judge_step(c, xs, t, start, ds, sphere, on_bound, o, angle_reject, self.ds_min,
+                          self._tangent_solve)
 
     def _fail(self, message: str) -> None:
         self.status = "failed"

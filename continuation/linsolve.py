@@ -44,6 +44,7 @@ from scipy.linalg import LinAlgWarning, lu_factor, lu_solve
 from scipy.linalg.lapack import dgesv, dgetrs
 
 REUSE_MIN_SIZE = 800      # below this a fresh LU is cheaper than a few Krylov iterations
+BLOCK_MIN_SIZE = 250      # below this a fresh LU is cheaper than block LUs and a Krylov step
 
 
 def direct_solve(A: np.ndarray, B: np.ndarray):
@@ -238,9 +239,11 @@ class BlockPreconditioned(ReusedLU):
 
 
 def make_solver(n: int, blocks=None):
-    """The linear solver for systems of ``n`` unknowns: :func:`direct_solve` below
-    :data:`REUSE_MIN_SIZE`, else :class:`BlockPreconditioned` on ``blocks`` (``(start, stop)``
-    ranges of the unknowns) when given, else :class:`ReusedLU`."""
-    if n < REUSE_MIN_SIZE:
-        return direct_solve
-    return BlockPreconditioned(blocks) if blocks else ReusedLU()
+    """The linear solver for systems of ``n`` unknowns: :class:`BlockPreconditioned` on
+    ``blocks`` (``(start, stop)`` ranges of the unknowns) when given and ``n`` reaches
+    :data:`BLOCK_MIN_SIZE`, else :class:`ReusedLU` from :data:`REUSE_MIN_SIZE`, else
+    :func:`direct_solve`.  (Measured on a 16-contact FE patch, 336 unknowns: FRF 2.06 s direct,
+    1.66 s on the blocks; at 84 and 168 unknowns the direct LU is 20 % and 12 % faster.)"""
+    if blocks and n >= BLOCK_MIN_SIZE:
+        return BlockPreconditioned(blocks)
+    return ReusedLU() if n >= REUSE_MIN_SIZE else direct_solve

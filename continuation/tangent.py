@@ -30,7 +30,7 @@ from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
 
 
 def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = None,
-                 rho: float | None = None) -> np.ndarray:
+                 rho: float | None = None, linear_solve=None) -> np.ndarray:
     """Unit null vector of ``Js`` with a positive component along ``t_ref``.
 
     Parameters
@@ -46,6 +46,10 @@ def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = No
     rho : float, optional
         ``||Js||_inf`` when the caller has it (:meth:`continuation.corrector.Evaluation.row_norm`);
         computed otherwise.
+    linear_solve : callable, optional
+        With ``work``: the path's solver of its Newton systems (:mod:`continuation.linsolve`),
+        ``(A, B) -> A^{-1} B`` or None, used instead of a new LU of ``work`` (a large path's
+        block preconditioner solves this system as it solves the corrector's).
 
     Returns
     -------
@@ -60,7 +64,11 @@ def null_tangent(Js: np.ndarray, t_ref: np.ndarray, work: np.ndarray | None = No
     rho = max(rho, 1e-300)
     rhs = np.zeros(n + 1)
     rhs[-1] = rho
-    if work is not None:
+    if work is not None and linear_solve is not None:
+        work[n] = rho * t_ref
+        v = linear_solve(work, rhs[:, None])
+        v = None if v is None else v[:, 0]
+    elif work is not None:
         work[n] = rho * t_ref
         lu, piv, info = dgetrf(work.T, overwrite_a=True)     # work.T is Fortran-ordered
         v = dgetrs(lu, piv, rhs, trans=1)[0] if info == 0 else None

@@ -48,11 +48,13 @@ def test_frf_with_iterative_solves_equals_direct_path(monkeypatch):
     case = _case("modal", 5)
     ref = frf(case, stability=False, fmax=0.8)
     monkeypatch.setattr(linsolve, "REUSE_MIN_SIZE", 1)
+    monkeypatch.setattr(linsolve, "BLOCK_MIN_SIZE", 1)
     new = frf(case, stability=False, fmax=0.8)
     assert ref.status == new.status == "finished"
     assert new.freq_hz.size == ref.freq_hz.size
     assert np.abs(new.freq_hz - ref.freq_hz).max() <= 1e-6 * ref.freq_hz.max()
     monkeypatch.setattr(linsolve, "REUSE_MIN_SIZE", 10 ** 9)
+    monkeypatch.setattr(linsolve, "BLOCK_MIN_SIZE", 10 ** 9)
     h, N, _, hi, tr = resolve_settings(case, fmax=0.8)
     problem, _ = build_problem(case, FourierBasis(h, N), tr, hi)      # the modes cover fmax
     F = np.abs(problem.load(2 * np.pi * ref.freq_hz[0])).max()
@@ -138,3 +140,22 @@ def test_singular_blocks_fall_back_to_the_whole_matrix():
     s = BlockPreconditioned(blocks, rtol=1e-12)
     X = s(A.copy(), B)
     assert s.factorisations == 1 and np.abs(A @ X - B).max() <= 1e-9 * np.abs(B).max()
+
+
+def test_tangent_on_the_block_solver_equals_the_direct_tangent():
+    """null_tangent's bordered system solved by the path's block solver (no LU of the whole
+    matrix) gives the tangent of the in-place LU."""
+    from continuation.tangent import null_tangent
+    A, _, blocks = _blocky(4, 30, 0.01, 10)
+    n = A.shape[0] - 1
+    Js = np.ascontiguousarray(A[:n])                      # (n, n + 1): a Jacobian with its w column
+    t_ref = np.ones(n + 1) / np.sqrt(n + 1)
+    work = np.empty((n + 1, n + 1))
+    work[:n] = Js
+    t_direct = null_tangent(Js, t_ref, work)
+    s = BlockPreconditioned(blocks, rtol=1e-12)
+    work[:n] = Js
+    t_block = null_tangent(Js, t_ref, work, linear_solve=s)
+    assert s.factorisations == 0 and s.block_solves == 1
+    assert np.abs(Js @ t_block).max() <= 1e-10 * np.abs(Js).max()
+    np.testing.assert_allclose(t_block, t_direct, atol=1e-10)
