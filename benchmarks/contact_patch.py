@@ -8,8 +8,10 @@ The window spans the first out-of-phase bending pair (interface shear).
 
 For every ``(n_c, H)`` a fresh process (so peak memory is the case's own) reports:
 unknowns, the time of one Newton iteration split into the linear part at a new frequency,
-the AFT and the dense solve, and a whole FRF (``--no-stability``; large cases stop after
-``--max-points`` points and report per point).  Writes ``benchmarks/results/contact_patch.csv``
+the AFT and the linear solve (the solver the continuation uses: block-preconditioned GMRES
+from 250 unknowns), a whole FRF (no stability; large cases stop after their ``max_points``
+and report per point) and, apart from it, the seconds of its per-point error estimate
+(``error_s``, NaN when skipped for size).  Writes ``benchmarks/results/contact_patch.csv``
 and ``contact_patch.png`` (log-log cost against ``n_c``).
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/contact_patch.py [--cases 16:3 64:3 128:7 200:7:12]
@@ -34,8 +36,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 MODEL_DIR = Path(tempfile.gettempdir()) / "hbm_contact_patch_model"
 FIELDS = ("n_c", "H", "n_unknowns", "linear_s", "aft_s", "solve_s", "points", "iterations",
-          "frf_s", "s_per_point", "s_per_iteration", "peak_mb", "status", "last_hz", "peak_hz", "peak_m",
-          "message")
+          "frf_s", "s_per_point", "s_per_iteration", "error_s", "peak_mb", "status", "last_hz", "peak_hz",
+          "peak_m", "message")
 
 
 def write_model():
@@ -97,6 +99,7 @@ def measure(n_c: int, H: int, max_points: int) -> dict:
     return {"n_c": n_c, "H": H, "n_unknowns": n_u, "linear_s": lin, "aft_s": aft,
             "solve_s": solve, "points": pts, "iterations": its, "frf_s": t, "s_per_point": t / max(pts, 1),
             "s_per_iteration": t / max(its, 1),
+            "error_s": float(res.settings["error_estimate"].get("seconds", float("nan"))),
             "peak_mb": peak_mb,
             "status": res.status, "last_hz": float(res.freq_hz[-1]) if h1.size else float("nan"),
             "peak_hz": float(res.freq_hz[k]) if h1.size else float("nan"),
@@ -105,8 +108,9 @@ def measure(n_c: int, H: int, max_points: int) -> dict:
 
 def _part_seconds(case):
     """``(n_unknowns, linear_s, aft_s, solve_s)``: best times of the linear part at a new
-    frequency, one AFT and one dense Newton solve, on a problem of its own (made after the
-    FRF, whose peak memory is reported before it)."""
+    frequency, one AFT and one Newton solve (:func:`continuation.linsolve.make_solver`), on a
+    problem of its own (made after the FRF, whose peak memory is reported before it)."""
+    from continuation.linsolve import make_solver
     from hbm.balance.fourier import FourierBasis
     from hbm.analyses.response import build_problem, resolve_settings
     h, N, lo, hi, tr = resolve_settings(case, None, None, None, None, None)
@@ -117,7 +121,8 @@ def _part_seconds(case):
     lin = _best(lambda: problem.linear._builder(w))
     d = problem.nl.dofs
     aft = _best(lambda: problem.nl.evaluate(np.ascontiguousarray(X[:, d]), w))
-    solve = _best(lambda: np.linalg.solve(J, R))
+    solver = make_solver(problem.n_unknowns, problem.harmonic_blocks())
+    solve = _best(lambda: solver(J, R[:, None]))
     return problem.n_unknowns, lin, aft, solve
 
 

@@ -302,3 +302,18 @@ def test_bad_builder_keys_are_rejected_by_name(tmp_path, mutate, needle):
     with pytest.raises(CaseError, match=needle.replace(".", r"\.")) as exc:
         load_case(p)
     assert "\n" not in str(exc.value)
+
+
+def test_case_without_a_file_is_reduced_once_per_run():
+    """A case built in Python has no file to cache its reduction beside: the FRF's error
+    estimate (a second problem on more harmonics) reuses the reduction in memory, and any
+    change of the reduction's inputs recomputes it."""
+    case = chain_case(inline("condensed", modes=6), JENKINS, f_hz=(1.2, 1.3))
+    res = frf(case, stability=False)
+    assert res.ok and res.settings["error_estimate"]["computed"]
+    assert res.settings["reduction_cached"] in (False, True)       # an earlier test may have made it
+    again = frf(case, stability=False)
+    assert again.settings["reduction_cached"] is True and again.settings["reduction_seconds"] == 0.0
+    assert np.array_equal(again.outputs["tip"].h1, res.outputs["tip"].h1)
+    other = frf(chain_case(inline("condensed", modes=7), JENKINS, f_hz=(1.2, 1.3)), stability=False)
+    assert other.settings["reduction_cached"] is False and other.settings["modes"] == 7

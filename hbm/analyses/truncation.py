@@ -17,16 +17,20 @@ relative error of each output's first harmonic is
 
     e = \frac{\big|\, |y_1(X + \delta)| - |y_1(X)| \,\big|}{|y_1(X + \delta)|}.
 
-It costs one residual, Jacobian and LU of the richer problem per point, so the FRF computes
-it when that problem has at most ``MAX_UNKNOWNS`` unknowns (its settings say so otherwise).
+It costs one residual, Jacobian and linear solve of the richer problem per point (solved
+like the continuation's: :func:`continuation.linsolve.make_solver` on its harmonic blocks, so a
+contact patch costs block LUs and a few Krylov steps, not a dense LU), and the FRF computes it
+when that problem has at most ``MAX_UNKNOWNS`` unknowns (its settings say so otherwise): the
+richer Jacobian is still formed densely, ``8 n^2`` bytes.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from continuation.linsolve import make_solver
 from hbm.balance.fourier import FourierBasis
 
-MAX_UNKNOWNS = 2000
+MAX_UNKNOWNS = 6000       # a richer Jacobian of 290 MB
 WARN_ERROR = 1e-2        # a point estimated worse than this is named in a warning
 SMALL_ERROR = 1e-7       # every point better than this: the harmonics are more than needed
 
@@ -79,13 +83,14 @@ def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
     """
     rp = richer_problem
     out = np.full((len(ws), rp.linear.output_rows.shape[0]), np.nan)
+    solve = make_solver(rp.n_unknowns, rp.harmonic_blocks())
     for k, (X, w) in enumerate(zip(Xs, ws)):
         Xr = embed(X, problem.basis, rp.basis)
         R, J = rp.residual(Xr, float(w))[:2]
-        try:
-            d = np.linalg.solve(J, -R)
-        except np.linalg.LinAlgError:
+        d = solve(J, -R[:, None])
+        if d is None or not np.all(np.isfinite(d)):
             continue
+        d = d[:, 0]
         y0 = _h1(rp.basis, rp.recover_outputs(Xr, float(w)))
         y1 = _h1(rp.basis, rp.recover_outputs(rp.expand(rp.unknowns(Xr) + d), float(w)))
         out[k] = np.abs(y1 - y0) / np.maximum(y1, 1e-300)

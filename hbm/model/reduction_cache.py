@@ -3,7 +3,9 @@
 The file holds the arrays of a :class:`hbm.model.reduction.ReducedModel` and a key: the SHA-256
 of the matrices, the damping specification, the number of modes, the residual-flexibility
 switch and the kept DOFs.  A file whose key differs is recomputed and overwritten; a
-folder that cannot be written only costs the caching.
+folder that cannot be written only costs the caching.  A case without a file (built in
+Python) keeps its last reduction in memory under its key instead, so that the same run's
+error estimate does not reduce it again (2-3 s on an 8100-DOF patch).
 """
 from __future__ import annotations
 
@@ -20,6 +22,7 @@ from hbm.model.reduction import ReducedModel
 from hbm.model.structure import Structure
 
 FORMAT = "hbm-reduction-1"
+_LAST: dict = {}          # {key: ReducedModel}: the last reduction of a case without a file
 
 
 @dataclass(frozen=True)
@@ -93,6 +96,8 @@ def reduce_cached(structure: Structure, keep_dofs, n_modes: int, residual_flexib
     """
     keep = np.asarray(keep_dofs, dtype=np.int64)
     key = reduction_key(structure, keep, n_modes, residual_flexibility)
+    if path is None and key in _LAST:
+        return CachedReduction(_LAST[key], 0.0, True, None)
     if path is not None:
         path = Path(path)
         if path.is_file():
@@ -102,5 +107,8 @@ def reduce_cached(structure: Structure, keep_dofs, n_modes: int, residual_flexib
     t0 = time.perf_counter()
     r = structure.reduce(keep, n_modes, residual_flexibility)
     secs = time.perf_counter() - t0
+    if path is None:
+        _LAST.clear()
+        _LAST[key] = r
     written = path is not None and _write(path, key, r)
     return CachedReduction(r, secs, False, str(path) if written else None)
