@@ -136,6 +136,10 @@ def plot(rows, path):
         nc = [r["n_c"] for r in rr]
         ax.loglog(nc, [r["s_per_iteration"] for r in rr], "o-", label=f"H = {H}: s per Newton iteration")
         ax.loglog(nc, [r["linear_s"] for r in rr], "s--", label=f"H = {H}: linear part per frequency")
+    ref = [r for r in rows if r["H"] == 3 and r["n_c"] == 16]
+    if ref:                 # what near-linear cost would be, through the 16-contact iteration
+        nc = np.array([4.0, 200.0])
+        ax.loglog(nc, ref[0]["s_per_iteration"] * nc / 16.0, ":", color="0.5", label="proportional to n_c")
     ax.set_xlabel("contact nodes n_c")
     ax.set_ylabel("seconds")
     ax.grid(True, which="both", alpha=0.3)
@@ -151,7 +155,16 @@ def main(argv=None):
                     help="n_c:H[:max_points] (default max_points 400)")
     ap.add_argument("--one", nargs=3, type=int, metavar=("NC", "H", "MAXPTS"), help=argparse.SUPPRESS)
     ap.add_argument("--out", default=str(HERE / "results" / "contact_patch"))
+    ap.add_argument("--replot", action="store_true", help="redraw the plot from the CSV at --out")
     args = ap.parse_args(argv)
+    base = Path(args.out)
+    if args.replot:
+        with open(base.with_suffix(".csv"), newline="") as fh:
+            ints = ("n_c", "H", "n_unknowns", "points", "iterations")
+            rows = [{k: v if k in ("status", "message") else int(v) if k in ints else float(v)
+                     for k, v in r.items()} for r in csv.DictReader(fh)]
+        plot(rows, base.with_suffix(".png"))
+        return
     write_model()
     if args.one:
         print(json.dumps(measure(*args.one)))
@@ -170,7 +183,6 @@ def main(argv=None):
         print(" ".join(f"{row[f]:>11.4g}" if isinstance(row[f], float) else f"{row[f]:>11}" for f in FIELDS[:-1]),
               flush=True)
         print(f"{'':>11} {row['message']}", flush=True)
-    base = Path(args.out)
     base.parent.mkdir(exist_ok=True)
     with open(base.with_suffix(".csv"), "w", newline="") as fh:
         wr = csv.DictWriter(fh, fieldnames=FIELDS)
