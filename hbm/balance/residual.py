@@ -84,14 +84,15 @@ class HarmonicBalance:
         return self.linear.unknowns(X)
 
     def harmonic_blocks(self) -> list:
-        """``[(start, stop), ...]``: the unknowns of each harmonic (its cosine and sine rows),
-        in order.  ``Z`` couples nothing across them; only the nonlinear Jacobian does, and
+        """``[(start, stop, paired), ...]``: the unknowns of each harmonic in order, its cosine
+        rows then its sine rows (``paired``: a harmonic above 0, whose linear part acts on
+        ``X_c - i X_s`` as one complex matrix).  ``Z`` couples nothing across them; only the nonlinear Jacobian does, and
         only through contacts whose stiffness varies over the period (slip, separation), so
         they precondition the Newton solves (:class:`continuation.linsolve.BlockPreconditioned`)."""
         nf = self.n_unknowns // self.basis.n_coef
         h = self.basis.h_of_row
         edges = np.flatnonzero(np.r_[True, h[1:] != h[:-1], True])
-        return [(int(a) * nf, int(b) * nf) for a, b in zip(edges[:-1], edges[1:])]
+        return [(int(a) * nf, int(b) * nf, bool(h[a] > 0)) for a, b in zip(edges[:-1], edges[1:])]
 
     # ------------------------------------------------------------------ residual
     def residual(self, X: np.ndarray, w: float):
