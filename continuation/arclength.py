@@ -108,10 +108,9 @@ class Arclength:
         LU, two ``n x n`` arrays in all while a step is corrected.
     describe_lam : callable, optional
         ``lam -> str`` naming a parameter value in messages (default ``"lam=<value>"``).
-    blocks : sequence of (int, int), optional
-        ``(start, stop)`` ranges of the unknowns coupled mainly among themselves: large
-        systems then precondition their Newton solves by these diagonal blocks first
-        (:class:`continuation.linsolve.BlockPreconditioned`).
+    blocks : sequence of (int, int[, bool]), optional
+        Ranges of unknowns coupled mainly among themselves: large systems precondition their
+        Newton solves by these diagonal blocks (:class:`continuation.linsolve.BlockPreconditioned`).
 
     Attributes
     ----------
@@ -173,8 +172,7 @@ class Arclength:
         # large systems keep an LU across Newton iterations and steps (continuation.linsolve);
         # callers may solve their own (n+1, n+1) systems with it (a fixed-parameter polish)
         self.linear_solve = make_solver(x0.size, blocks)
-        # the tangent's bordered system on the same solver when it is iterative (a direct
-        # one factors the matrix in place, null_tangent's own way)
+        # tangents on the same solver when iterative (else null_tangent's in-place LU)
         self._tangent_solve = None if self.linear_solve is direct_solve else self.linear_solve
 
     # ------------------------------------------------------------------ evaluation

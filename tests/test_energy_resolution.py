@@ -1,48 +1,26 @@
 """The energy balance's resolution on a condensed FE contact patch next to a mode its stuck
 contacts block (hbm.balance.condensed.CondensedLinear.work_resolution).
 
-Two small clamped columns (882 DOFs, :mod:`fe_columns` of the benchmarks) meet on 16
+Two small clamped columns (882 DOFs, ``tests/fe_patch.py``) meet on 16
 ``friction3d`` contacts that stay stuck (0.05 % modal damping): the response is linear and its
 exact solution is one linear solve.  The free structure (contacts open) has a mode pair at 7004.7 Hz that the stuck
 contacts block; there ``H_cc`` is nearly singular and the residual's ``Z = H_cc^{-1}`` and the
 works' modal sums agree only to ``eps cond(H_cc)``: the energy imbalance of the exact solution
 (1e-8 of the works, residual 1e-13) is that disagreement, which the resolution states."""
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
-import scipy.io
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-
-from fe_columns import column_pair                       # noqa: E402
-from hbm.analyses.problem_setup import build_problem, resolve_settings   # noqa: E402
-from hbm.analyses.response import frf                    # noqa: E402
-from hbm.balance.fourier import FourierBasis             # noqa: E402
-from hbm.interface.case import case_from_dict            # noqa: E402
+from fe_patch import column_patch_case
+from hbm.analyses.problem_setup import build_problem, resolve_settings
+from hbm.analyses.response import frf
+from hbm.balance.fourier import FourierBasis
 
 F_MODE = 7004.74          # Hz, the blocked mode pair of column_pair(n_s=6, n_z=3)
 
 
 @pytest.fixture(scope="module")
 def patch_case(tmp_path_factory):
-    d = tmp_path_factory.mktemp("cols")
-    cp = column_pair(n_s=6, n_z=3)
-    scipy.io.mmwrite(str(d / "c_K.mtx"), cp.K, symmetry="symmetric")
-    scipy.io.mmwrite(str(d / "c_M.mtx"), cp.M, symmetry="symmetric")
-    (d / "c_dofs.txt").write_text("\n".join(cp.dof_names) + "\n")
-    n_c = 16
-    els = []
-    for i, (a, b) in enumerate(cp.pairs[:n_c]):
-        rel = {q: [[f"A.n{a}.{q}", 1.0], [f"B.n{b}.{q}", -1.0]] for q in "xyz"}
-        els.append({"type": "friction3d", "name": f"c{i}", "dofs": {"t1": rel["x"], "t2": rel["y"], "n": rel["z"]},
-                    "kt": 2e7 / n_c, "kn": 4e7 / n_c, "mu": 0.5, "normal_preload": 500.0 / n_c})
-    return case_from_dict({
-        "model": {"file": str(d / "c_K.mtx"), "modal_damping": 0.0005, "solver": "condensed", "modes": 20,
-                  "residual_flexibility": True},
-        "element": els, "excitation": {"dofs": [cp.drive], "amplitude": [20.0]},
-        "analysis": {"harmonics": 3, "frequency_hz": [6900.0, 7100.0], "outputs": {"drive": cp.drive}}}, path="cols")
+    return column_patch_case(tmp_path_factory.mktemp("cols"), 16, 0.0005, (6900.0, 7100.0))
 
 
 def _exact_stuck(problem, w):

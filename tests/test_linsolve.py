@@ -188,3 +188,32 @@ def test_paired_blocks_are_exact_on_time_invariant_harmonics():
     X2 = s(np.ascontiguousarray(A2), B)
     assert s.factorisations == 0 and s.krylov_iterations > 4
     assert np.abs(A2 @ X2 - B).max() <= 1e-10 * np.abs(B).max()
+
+
+def test_block_solves_give_the_direct_frf_on_a_4_contact_fe_patch(monkeypatch, tmp_path):
+    """The issue's check on an FE patch: 4 friction3d contacts between two brick columns (84
+    unknowns, condensed; 1 kN, every contact slipping, so the blocks only precondition),
+    traced on the block solver (forced on below its size) and by direct LUs: at each point's
+    frequency the block path's coefficients equal a direct Newton solve's from the direct
+    path's point to 1e-8."""
+    from fe_patch import column_patch_case
+    from hbm.analyses.response import frf
+    from hbm.analyses.problem_setup import build_problem, resolve_settings
+    from hbm.balance.fourier import FourierBasis
+    from hbm.balance.newton import newton
+    case = column_patch_case(tmp_path, 4, 0.002, (8200.0, 8700.0), force=1000.0)
+    ref = frf(case, stability=False, error_estimate=False)
+    monkeypatch.setattr(linsolve, "BLOCK_MIN_SIZE", 1)
+    new = frf(case, stability=False, error_estimate=False)
+    assert ref.status == new.status == "finished" and new.freq_hz.size == ref.freq_hz.size
+    assert np.all(new.stuck == 0)
+    monkeypatch.setattr(linsolve, "BLOCK_MIN_SIZE", 10 ** 9)
+    h, N, _, hi, tr = resolve_settings(case)
+    problem, _ = build_problem(case, FourierBasis(h, N), tr, hi)
+    F = np.abs(problem.load(2 * np.pi * ref.freq_hz[0])).max()
+    for X, f, X0 in zip(new.X, new.freq_hz, ref.X):
+        w = 2 * np.pi * f
+        res = newton(lambda u: problem.residual(problem.expand(u), w)[:2], problem.unknowns(X0),
+                     r_scale=F, tol=1e-13, linear_solve=direct_solve)
+        assert res.converged, res.message
+        assert np.abs(X - problem.expand(res.x)).max() <= 1e-8 * np.abs(X).max()

@@ -79,8 +79,8 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
     overwrite_jacobian : bool
         ``fun`` returns a new ``J`` on every call, which may be scaled in place (no copy of an
         ``n x n`` matrix per update).
-    blocks : sequence of (int, int), optional
-        ``(start, stop)`` ranges of unknowns coupled mainly among themselves (e.g.
+    blocks : sequence of (int, int[, bool]), optional
+        Ranges of unknowns coupled mainly among themselves (e.g.
         :meth:`hbm.balance.residual.HarmonicBalance.harmonic_blocks`).
 
     Returns
