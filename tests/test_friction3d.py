@@ -294,6 +294,22 @@ PATCH_U = np.array([[1.832e-04, 1.6556e-05, 0.0],
                     [-7.8120e-04, -2.5433e-05, -1.6894e-08]])
 
 
+def _newton_and_plain(el, U, plain_passes, plain_tol):
+    """One loop of ``el`` on coefficients ``U`` (n_coef, 3), H = 3, N = 128:
+    ``(z, f, passes, f_plain, plain)``, the samples, the Newton closure's forces and passes,
+    and the plain passes' (at most ``plain_passes``)."""
+    from elements.law_march import march_of, CLOSE_PLAIN
+    basis = FourierBasis(np.array([0, 1, 2, 3]), 128)
+    z = np.ascontiguousarray(basis.E @ U)
+    dz = np.zeros(z.shape + (1,))
+    start = el.start_index(z[:, :el.n_local])
+    f, _, passes = march_newton(el.kind, el.params, el.n_state, el.n_local, z, dz, start, el.max_passes,
+                                el.closure_tol)
+    f_plain, _, plain = march_of(el.kind, CLOSE_PLAIN)(el.params, el.n_state, el.n_local, z, dz, start,
+                                                      plain_passes, plain_tol)
+    return z, f, passes, f_plain, plain
+
+
 @pytest.mark.parametrize("unit", [1e-5, 1.0])
 def test_newton_closure_does_not_mix_units(unit):
     """The same loop in SI units (kt = 1.25e6 N/m, |u| ~ 1e-5 m) and in scaled units closes in
@@ -301,17 +317,9 @@ def test_newton_closure_does_not_mix_units(unit):
     plain passes.  The closure's condition number of ``I - M`` once mixed the force and
     displacement states (1e14 in SI units): Newton was refused and 1000 plain passes did not
     close the loop."""
-    from elements.law_march import march_of, CLOSE_PLAIN
     el = make(2, kt=12.5 / unit, kn=25.0 / unit, mu=0.5, n0=31.25)
-    basis = FourierBasis(np.array([0, 1, 2, 3]), 128)
-    z = np.ascontiguousarray(basis.E @ (PATCH_U * unit))
-    dz = np.zeros(z.shape + (1,))
-    start = el.start_index(z[:, :el.n_local])
-    f, _, passes = march_newton(el.kind, el.params, el.n_state, el.n_local, z, dz, start, el.max_passes,
-                                el.closure_tol)
+    z, f, passes, f_plain, plain = _newton_and_plain(el, PATCH_U * unit, 20000, 1e-14)
     assert 0 < passes <= 12
-    f_plain, _, plain = march_of(el.kind, CLOSE_PLAIN)(el.params, el.n_state, el.n_local, z, dz, start,
-                                                      20000, 1e-14)
     assert plain > 200                              # a slowly contracting loop indeed
     np.testing.assert_allclose(f, f_plain, atol=1e-9 * 15.6)
     assert el.summary(f, z)["slip_fraction"] > 0
@@ -330,17 +338,9 @@ def test_newton_closure_is_tried_again_after_a_pass_that_did_not_contract():
     """A Newton step across a change of the stick/slip pattern raises the residual; plain
     passes then follow for a while and Newton is tried again.  Turned off for good (as it was),
     this loop marched its 1000 periods unclosed; plain passes alone need 99 190."""
-    from elements.law_march import march_of, CLOSE_PLAIN
     el = make(2, kt=5e6, kn=1e7, mu=0.5, n0=125.0)
-    basis = FourierBasis(np.array([0, 1, 2, 3]), 128)
-    z = np.ascontiguousarray(basis.E @ (BARELY_U * 1e-5))
-    dz = np.zeros(z.shape + (1,))
-    start = el.start_index(z[:, :el.n_local])
-    f, _, passes = march_newton(el.kind, el.params, el.n_state, el.n_local, z, dz, start, el.max_passes,
-                                el.closure_tol)
+    _, f, passes, f_plain, plain = _newton_and_plain(el, BARELY_U * 1e-5, 200000, el.closure_tol)
     assert 0 < passes <= 50
-    f_plain, _, plain = march_of(el.kind, CLOSE_PLAIN)(el.params, el.n_state, el.n_local, z, dz, start,
-                                                      200000, el.closure_tol)
     assert plain > 50000
     # the plain march stops within tol / (1 - 0.99988) of its fixed point: 1e-8 relative
     np.testing.assert_allclose(f, f_plain, atol=2e-8 * 62.5)
