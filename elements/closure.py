@@ -102,7 +102,8 @@ def _close_or_update(s, s_begin, ds, ds_begin, Ms, tol, passes, last_res, newton
 
     ``s`` (ns,), ``ds`` (ns, P) at the end of the pass, ``s_begin``, ``ds_begin`` at its start,
     ``Ms`` (ns, ns) the period map's derivative; ``newton_wait`` plain passes are left before
-    Newton may be tried again.  Returns ``(closed, last_res, newton_wait, seeds_fixed)``.  Law-independent, so compiled once (not inlined into every law's march).
+    Newton may be tried again.  Returns ``(closed, last_res, newton_wait, seeds_fixed)``.
+    Law-independent, so compiled once (not inlined into every law's march).
     """
     ns, P = ds.shape
     scale = 0.0

@@ -1,12 +1,13 @@
 """The energy balance's resolution on a condensed FE contact patch next to a mode its stuck
 contacts block (hbm.balance.condensed.CondensedLinear.work_resolution).
 
-Two small clamped columns (882 DOFs, ``tests/fe_patch.py``) meet on 16
-``friction3d`` contacts that stay stuck (0.05 % modal damping): the response is linear and its
-exact solution is one linear solve.  The free structure (contacts open) has a mode pair at 7004.7 Hz that the stuck
-contacts block; there ``H_cc`` is nearly singular and the residual's ``Z = H_cc^{-1}`` and the
-works' modal sums agree only to ``eps cond(H_cc)``: the energy imbalance of the exact solution
-(1e-8 of the works, residual 1e-13) is that disagreement, which the resolution states."""
+Two small clamped columns (882 DOFs, ``tests/fe_patch.py``) meet on 16 ``friction3d``
+contacts that stay stuck (0.05 % modal damping): the response is linear and its exact
+solution is one linear solve.  The free structure (contacts open) has a mode pair at
+7004.7 Hz that the stuck contacts block; there ``H_cc`` is nearly singular and the
+residual's ``Z = H_cc^{-1}`` and the works' modal sums agree only to ``eps cond(H_cc)``: the
+energy imbalance of the exact solution (1e-8 of the works, residual 1e-13) is that
+disagreement, which the resolution states."""
 import numpy as np
 import pytest
 

@@ -108,7 +108,8 @@ def _blocky(n_blocks, size, coupling, seed):
     A[n, :n] = rng.normal(size=n)
     A[:n, n] = rng.normal(size=n)
     A[n, n] = 0.5
-    return np.ascontiguousarray(A), rng.normal(size=(n + 1, 2)), [(k * size, (k + 1) * size) for k in range(n_blocks)]
+    blocks = [(k * size, (k + 1) * size) for k in range(n_blocks)]
+    return np.ascontiguousarray(A), rng.normal(size=(n + 1, 2)), blocks
 
 
 def test_block_preconditioner_is_exact_on_a_block_diagonal_bordered_matrix():

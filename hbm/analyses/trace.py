@@ -155,7 +155,8 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
         if err > ENERGY_LIMIT + 2 * floor:
             return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
                     f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "
-                    f"after polishing, resolution there {floor:.1e}); the {len(pts.w)} points before it are kept",
+                    f"after polishing, resolution there {floor:.1e}); the {len(pts.w)} points before it "
+                    f"are kept",
                     [f / (2 * np.pi) for f in solver.folds], solver.n_rejected)
         pts.X.append(X)
         pts.w.append(w)

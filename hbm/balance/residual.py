@@ -86,9 +86,10 @@ class HarmonicBalance:
     def harmonic_blocks(self) -> list:
         """``[(start, stop, paired), ...]``: the unknowns of each harmonic in order, its cosine
         rows then its sine rows (``paired``: a harmonic above 0, whose linear part acts on
-        ``X_c - i X_s`` as one complex matrix).  ``Z`` couples nothing across them; only the nonlinear Jacobian does, and
-        only through contacts whose stiffness varies over the period (slip, separation), so
-        they precondition the Newton solves (:class:`continuation.linsolve.BlockPreconditioned`)."""
+        ``X_c - i X_s`` as one complex matrix).  ``Z`` couples nothing across harmonics; only
+        the nonlinear Jacobian does, through contacts whose stiffness varies over the period
+        (slip, separation), so the blocks precondition the Newton solves
+        (:class:`continuation.linsolve.BlockPreconditioned`)."""
         nf = self.n_unknowns // self.basis.n_coef
         h = self.basis.h_of_row
         edges = np.flatnonzero(np.r_[True, h[1:] != h[:-1], True])
