@@ -47,6 +47,11 @@ REUSE_MIN_SIZE = 800      # below this a fresh LU is cheaper than a few Krylov i
 BLOCK_MIN_SIZE = 250      # below this a fresh LU is cheaper than block LUs and a Krylov step
 
 
+def _usable(lu) -> bool:
+    """An LU factor (``lu_factor``'s) that is finite and has no zero pivot."""
+    return bool(np.all(np.isfinite(lu[0])) and not np.any(np.diag(lu[0]) == 0.0))
+
+
 def direct_solve(A: np.ndarray, B: np.ndarray):
     """``A^{-1} B`` by LU (LAPACK ``dgesv``; ``A`` is overwritten when Fortran-ordered, ``B``
     is not), None if ``A`` is exactly singular.  ``np.linalg.solve`` costs about 20 us more
@@ -117,8 +122,7 @@ class ReusedLU:
                 lu = lu_factor(A.T if trans else A, overwrite_a=False, check_finite=False)
         except (ValueError, np.linalg.LinAlgError):
             return None
-        if not np.all(np.isfinite(lu[0])) or np.any(np.diag(lu[0]) == 0.0):
-            self._lu = None
+        if not _usable(lu):
             return None
         self._lu, self._trans = lu, trans
         self.factorisations += 1
@@ -222,7 +226,7 @@ class BlockPreconditioned(ReusedLU):
                     m = (b - a) // 2
                     Ab = 0.5 * (Ab[:m, :m] + Ab[m:, m:]) - 0.5j * (Ab[:m, m:] - Ab[m:, :m])
                 lu = lu_factor(Ab, check_finite=False)
-                if not np.all(np.isfinite(lu[0])) or np.any(np.diag(lu[0]) == 0.0):
+                if not _usable(lu):
                     return None
                 lus.append(lu)
 

@@ -68,9 +68,8 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
     x0 = np.r_[problem.unknowns(X), w]
     first = bordered(x0)
     explained = np.pi * abs(first[0][:-1] @ problem.unknowns(problem.basis.D @ X))
-    imbalance = abs(eb.excitation - eb.viscous - eb.nonlinear)
-    if explained < 0.1 * imbalance:
-        return X, err, err * problem.energy_resolution(X, w) / imbalance
+    if explained < 0.1 * abs(eb.excitation - eb.viscous - eb.nonlinear):
+        return X, err, _resolution(problem, X, w, eb)
     calls = iter([first])                     # Newton's first call gets the evaluation at hand
     del first                                 # (its Jacobian is then not held past that call)
     res = newton(lambda u: next(calls, None) or bordered(u), x0, scale=np.r_[xscale, w_scale],
@@ -81,6 +80,20 @@ def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
         if err_p < err:
             return Xp, err_p, 0.0
     return X, err, 0.0
+
+
+def _resolution(problem, X, w, eb) -> float:
+    """The energy balance's resolution at ``(X, w)`` (the linear part's share of the
+    imbalance, :meth:`hbm.balance.residual.HarmonicBalance.energy_resolution`) in the measure of
+    ``eb.relative_error``."""
+    imbalance = abs(eb.excitation - eb.viscous - eb.nonlinear)
+    return eb.relative_error * problem.energy_resolution(X, w) / imbalance if imbalance else 0.0
+
+
+def _refused(err: float, floor: float) -> bool:
+    """A point's energy error above what the FRF reports: ``ENERGY_LIMIT`` plus twice the
+    balance's resolution ``floor`` there (same measure)."""
+    return err > ENERGY_LIMIT + 2 * floor
 
 
 class _Path:
@@ -152,7 +165,7 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
         err, floor = eb.relative_error, 0.0
         if err > POLISH_ENERGY:
             X, err, floor = _polish(problem, X, w, xscale, r_scale, eb, solver.linear_solve, scale[-1])
-        if err > ENERGY_LIMIT + 2 * floor:
+        if _refused(err, floor):
             return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
                     f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "
                     f"after polishing, resolution there {floor:.1e}); the {len(pts.w)} points before it "
@@ -242,8 +255,9 @@ def _fresh_point_past(problem, case, w_from, window, xscale, r_scale):
             if k >= len(ladder):
                 why = str(exc)
             continue
-        err = energy_balance(problem, Xr, w_r).relative_error
-        if err <= ENERGY_LIMIT:
+        eb = energy_balance(problem, Xr, w_r)
+        err = eb.relative_error
+        if not _refused(err, 0.0) or not _refused(err, _resolution(problem, Xr, w_r, eb)):
             return Xr, itr, w_r
         if k >= len(ladder):
             why = f"the time-domain start's energy balance did not close ({err:.1e})"
