@@ -214,8 +214,10 @@ class CondensedLinear:
         R, dRw : ndarray, shape (n_u,)
         """
         L = self.at(w)
-        assemble(L.Z, L.hdZ, self._h, self._rc, L.F, L.dF, np.ascontiguousarray(X.reshape(-1), dtype=float),
+        assemble(L.Z, self._h, self._rc, L.F, L.dF, np.ascontiguousarray(X.reshape(-1), dtype=float),
                  np.ascontiguousarray(Fn.reshape(-1)), np.ascontiguousarray(dFw.reshape(-1)), J, R, dRw)
+        dZU = (L.hdZ @ self._complex(X.reshape(-1, self.n_dof))[:, :, None])[:, :, 0]
+        dRw += self._real(dZU).reshape(-1)
 
     def modal_data(self, rows: np.ndarray) -> ModalData:
         """The kept modes and residual flexibility seen from the contact coordinates ``rows``

@@ -195,16 +195,16 @@ def proportional_linear(Pu, ia, ib, p, om2, c, Ru, hs, w, rows, nc, ie, i1):
 
 
 @nb.njit(cache=True)
-def assemble(Z, hdZ, hs, rows, F0, dF0, x, Fn, dFw, J, R, dRw):
-    """Residual ``R = Z U - F0 + Fn``, ``dR/dw = h Z' U - dF0 + dFw`` and ``J += J_Z``, written
+def assemble(Z, hs, rows, F0, dF0, x, Fn, dFw, J, R, dRw):
+    """Residual ``R = Z U - F0 + Fn``, ``dR/dw = dFw - dF0`` (the caller adds ``h Z' U``) and ``J += J_Z``, written
     into ``R`` and ``dRw`` (n_u,) and added to ``J`` (n_u, n_u), which holds the nonlinear
     forces' Jacobian on entry (views allowed); ``J_Z`` is ``Z`` in real block form per harmonic
     (module doc).  No ``n_u x n_u`` matrix of the linear part is formed.
 
     Parameters
     ----------
-    Z, hdZ : ndarray, complex, shape (n_h, n_c, n_c)
-        Condensed stiffness and ``h dZ/dW`` per harmonic.
+    Z : ndarray, complex, shape (n_h, n_c, n_c)
+        Condensed stiffness per harmonic.
     hs : ndarray, shape (n_h,)
     rows : ndarray of int, shape (n_h,)
         Cosine (or mean) row of each harmonic; the sine row follows it.
@@ -232,7 +232,7 @@ def assemble(Z, hdZ, hs, rows, F0, dF0, x, Fn, dFw, J, R, dRw):
             continue
         s0 = c0 + nc
         for a in range(nc):
-            rc, rs, dc, ds = 0.0, 0.0, 0.0, 0.0
+            rc, rs = 0.0, 0.0
             for b in range(nc):
                 zr, zi = Z[k, a, b].real, Z[k, a, b].imag
                 J[c0 + a, c0 + b] += zr
@@ -242,10 +242,5 @@ def assemble(Z, hdZ, hs, rows, F0, dF0, x, Fn, dFw, J, R, dRw):
                 xc, xs = x[c0 + b], x[s0 + b]
                 rc += zr * xc + zi * xs
                 rs += zr * xs - zi * xc
-                dr, di = hdZ[k, a, b].real, hdZ[k, a, b].imag
-                dc += dr * xc + di * xs
-                ds += dr * xs - di * xc
             R[c0 + a] += rc
             R[s0 + a] += rs
-            dRw[c0 + a] += dc
-            dRw[s0 + a] += ds

@@ -17,7 +17,10 @@ Gauss-Jordan per harmonic (:mod:`hbm.balance.condensed_kernels`).
     \frac{dZ}{dW} = B M^{-1} D'(W) M^{-1} B^T, \quad D' = -2W I + i C_m ,
 
 so a frequency costs ``O(m^3 + n_c^2 m)`` per harmonic instead of ``O(n_c^3)``, and
-``D^{-1}`` (singular at an undamped resonance) never appears in ``Z``.
+``D^{-1}`` (singular at an undamped resonance) never appears in ``Z``.  ``B`` being real, ``Z``
+takes two real products of ``n_c^2 m`` (not one complex one), and ``h dZ/dW`` is kept as its
+factors ``G = B M^{-1}`` and ``h D'`` (:class:`Congruence`): the balance only multiplies it
+by the displacements, ``O(n_c m)`` per harmonic.
 
 *dense* (many contacts, ``R_cc`` singular, e.g. all modes kept): ``H_cc`` formed and
 inverted by LAPACK per harmonic.
@@ -41,13 +44,35 @@ _RCOND_MIN = 1e-10             # smallest eigenvalue ratio of R_cc for the Woodb
 STRATEGIES = ("auto", "compiled", "woodbury", "dense")
 
 
+class Congruence(NamedTuple):
+    """``G D G^T`` kept as its factors; ``@`` multiplies without forming it.
+
+    Attributes
+    ----------
+    G : ndarray, complex, shape (..., n_c, m)
+    D : ndarray, complex, shape (..., m, m)
+    """
+
+    G: np.ndarray
+    D: np.ndarray
+
+    def __matmul__(self, U: np.ndarray) -> np.ndarray:
+        """``G D G^T U`` for ``U`` of shape (..., n_c, k) (or (n_c,) on one harmonic)."""
+        return self.G @ (self.D @ (np.swapaxes(self.G, -1, -2) @ U))
+
+    def __getitem__(self, k) -> "Congruence":
+        return Congruence(self.G[k], self.D[k])
+
+
 class LinearPart(NamedTuple):
     """The linear part at one fundamental frequency ``w``.
 
     Attributes
     ----------
-    Z, hdZ : ndarray, complex, shape (n_h, n_c, n_c)
-        ``Z_c(h w)`` and ``h dZ_c/dW`` per harmonic (``dR/dw`` of ``Z_c U``).
+    Z : ndarray, complex, shape (n_h, n_c, n_c)
+        ``Z_c(h w)`` per harmonic.
+    hdZ : ndarray, complex, shape (n_h, n_c, n_c), or Congruence
+        ``h dZ_c/dW`` per harmonic (``dR/dw`` of ``Z_c U``); only ever multiplied (``@``).
     F, dF : ndarray, shape (n_u,)
         Equivalent contact load ``F_eq`` and ``dF_eq/dw``, flattened like the unknowns.
     Hx : ndarray, complex, shape (n_h, n_e + n_o, n_c + n_e)
@@ -56,7 +81,7 @@ class LinearPart(NamedTuple):
     """
 
     Z: np.ndarray
-    hdZ: np.ndarray
+    hdZ: np.ndarray | Congruence
     F: np.ndarray
     dF: np.ndarray
     Hx: np.ndarray
@@ -132,15 +157,14 @@ class LinearBuilder:
         dD[:, ar, ar] -= 2.0 * Ws[:, None]
         return D, dD
 
-    def _receptance_rows(self, Ws, D, dD, xr, yc):
-        """``H`` and ``dH/dW`` between rows ``xr`` and columns ``yc`` of the kept coordinates,
-        (n_W, len(xr), len(yc)) complex, from ``D`` and ``D'``."""
+    def _receptance_rows(self, Dinv, xr, yc, dD=None):
+        """``H`` (and ``dH/dW`` when ``dD`` is given, else None) between rows ``xr`` and
+        columns ``yc`` of the kept coordinates, (n_W, len(xr), len(yc)) complex, from
+        ``D^{-1}`` and ``D'`` (n_W, m, m)."""
         px, py = self.phi[xr], self.phi[yc]
-        Dy = np.linalg.solve(D, np.broadcast_to(py.T.astype(complex), (Ws.size,) + py.T.shape))
-        H = px @ Dy + self.R[np.ix_(xr, yc)]
-        Dx = np.linalg.solve(D.transpose(0, 2, 1), np.broadcast_to(px.T.astype(complex), (Ws.size,) + px.T.shape))
-        dH = -(Dx.transpose(0, 2, 1) @ (dD @ Dy))
-        return H, dH
+        A = px @ Dinv                                                # (n_W, len(xr), m)
+        H = A @ py.T + self.R[np.ix_(xr, yc)]
+        return H, (None if dD is None else -(A @ dD) @ (Dinv @ py.T))
 
     def _load(self, Z, hdZ, Hce, dHce):
         """``F_eq`` and ``dF_eq/dw`` (n_u,) from harmonic 1's ``Z``, ``Z'`` and ``H_ce`` (n_c,)."""
@@ -181,35 +205,37 @@ class LinearBuilder:
         Ws = self.hs * w
         D, dD = self._modal(Ws)
         G = self._B @ np.linalg.inv(D + self._S)                     # B M^{-1}, (n_h, n_c, m)
-        Z = self._Rinv - G @ self._B.T
-        hdZ = self.hs[:, None, None] * (G @ dD @ G.transpose(0, 2, 1))
-        return self._finish(w, Z, hdZ, D, dD)
+        nc = self.nc
+        GB = np.concatenate((G.real, G.imag), axis=1) @ self._B.T     # (n_h, 2 n_c, n_c) real
+        Z = np.empty((Ws.size, nc, nc), dtype=complex)
+        Z.real, Z.imag = self._Rinv - GB[:, :nc], -GB[:, nc:]
+        hdZ = Congruence(G, self.hs[:, None, None] * dD)
+        return self._finish(w, Z, hdZ, np.linalg.inv(D), dD)
 
     def _dense(self, w):
         Ws = self.hs * w
         D, dD = self._modal(Ws)
         c = np.r_[0:self.nc]
-        Hcc, dHcc = self._receptance_rows(Ws, D, dD, c, c)
         try:
+            Dinv = np.linalg.inv(D)
+            Hcc, dHcc = self._receptance_rows(Dinv, c, c, dD)
             Z = np.linalg.inv(Hcc)
         except np.linalg.LinAlgError:
             raise ValueError("contact receptance is singular (dependent contact coordinates?)") from None
         hdZ = -self.hs[:, None, None] * (Z @ dHcc @ Z)
-        return self._finish(w, Z, hdZ, D, dD)
+        return self._finish(w, Z, hdZ, Dinv, dD)
 
-    def _finish(self, w, Z, hdZ, D, dD):
+    def _finish(self, w, Z, hdZ, Dinv, dD):
         """The load and the output receptances shared by the numpy strategies."""
-        Ws = self.hs * w
-        Hx, _ = self._receptance_rows(Ws, D, dD, self._x, self._y)
+        Hx, _ = self._receptance_rows(Dinv, self._x, self._y)
         i1, nc = self.i1, self.nc
-        Hce, dHce = self._receptance_rows(Ws[i1:i1 + 1], D[i1:i1 + 1], dD[i1:i1 + 1], np.r_[0:nc],
-                                          np.r_[nc:nc + self.ne])
+        Hce, dHce = self._receptance_rows(Dinv[i1:i1 + 1], np.r_[0:nc], np.r_[nc:nc + self.ne], dD[i1:i1 + 1])
         F, dF = self._load(Z, hdZ, Hce[0] @ self.fe, dHce[0] @ self.fe)
         return LinearPart(Z, hdZ, F, dF, Hx)
 
     def receptances(self, Ws, rows, cols):
         """``H`` between kept coordinates ``rows`` and ``cols`` at ``Ws``, (n_W, len(rows), len(cols))."""
         Ws = np.ascontiguousarray(Ws, dtype=float)
-        D, dD = self._modal(Ws)
-        return self._receptance_rows(Ws, D, dD, np.asarray(rows), np.asarray(cols))[0]
+        D, _ = self._modal(Ws)
+        return self._receptance_rows(np.linalg.inv(D), np.asarray(rows), np.asarray(cols))[0]
 
