@@ -121,7 +121,7 @@ def _part_seconds(case):
     lin = _best(lambda: problem.linear._builder(w))
     d = problem.nl.dofs
     aft = _best(lambda: problem.nl.evaluate(np.ascontiguousarray(X[:, d]), w))
-    solver = make_solver(problem.n_unknowns, problem.harmonic_blocks())
+    solver = make_solver(problem.n_unknowns, problem.solver_structure())
     solve = _best(lambda: solver(J, R[:, None]))
     return problem.n_unknowns, lin, aft, solve
 

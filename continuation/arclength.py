@@ -171,7 +171,7 @@ class Arclength:
         self._rho0: float | None = None
         # large systems keep an LU across Newton iterations and steps (continuation.linsolve);
         # callers may solve their own (n+1, n+1) systems with it (a fixed-parameter polish)
-        self.linear_solve = make_solver(x0.size, blocks)
+        self.linear_solve = make_solver(x0.size, blocks, scale=self.scale)
         # tangents on the same solver when iterative (else null_tangent's in-place LU)
         self._tangent_solve = None if self.linear_solve is direct_solve else self.linear_solve
 

@@ -33,7 +33,7 @@ def solve_near(problem, guess, w, radius, xscale, r_scale, tol=1e-10):
     fails or lands farther than ``radius`` from the guess (another branch coexisting at ``w``)."""
     fun = lambda u: problem.residual(problem.expand(u), w)[:2]
     res = newton(fun, problem.unknowns(guess), scale=xscale, r_scale=r_scale, tol=tol,
-                 blocks=problem.harmonic_blocks())
+                 blocks=problem.solver_structure())
     if not res.converged:
         return None
     X = problem.expand(res.x)

@@ -189,7 +189,7 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
     the traced ramp cost half the run on the cross beam and found nothing the next try did not).
     """
     fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
-    blocks = problem.harmonic_blocks()
+    blocks = problem.solver_structure()
     guesses = [problem.linear_solution(w0, problem.stuck_stiffness()), problem.linear_solution(w0)]
     last = None
     for g in guesses:

@@ -68,7 +68,7 @@ def time_domain_start(problem, case, w: float, xscale, r_scale):
     X = fit_harmonics(problem.basis, w, run.history.t, run.history.q)
     fun = lambda u: problem.residual(problem.expand(u), w)[:2]      # noqa: E731
     res = newton(fun, problem.unknowns(X), scale=xscale, r_scale=r_scale, overwrite_jacobian=True,
-                 blocks=problem.harmonic_blocks())
+                 blocks=problem.solver_structure())
     if not res.converged:
         raise RuntimeError(f"Newton from a time integration's periodic response: {res.message}")
     return problem.expand(res.x), res.iterations

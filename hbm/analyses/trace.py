@@ -156,7 +156,7 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     scale = np.r_[xscale, bounds[1] - bounds[0]]
     solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
                        direction=direction, options=opts, lam_step=lam_step, overwrite_jacobian=True,
-                       fun_into=problem.call_into, blocks=problem.harmonic_blocks(),
+                       fun_into=problem.call_into, blocks=problem.solver_structure(),
                        describe_lam=lambda lam: f"{lam / (2 * np.pi):.6g} Hz")
     for pt in solver:
         X = problem.expand(pt.x[:-1])

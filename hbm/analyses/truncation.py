@@ -83,7 +83,7 @@ def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
     """
     rp = richer_problem
     out = np.full((len(ws), rp.linear.output_rows.shape[0]), np.nan)
-    solve = make_solver(rp.n_unknowns, rp.harmonic_blocks())
+    solve = make_solver(rp.n_unknowns, rp.solver_structure())
     for k, (X, w) in enumerate(zip(Xs, ws)):
         Xr = embed(X, problem.basis, rp.basis)
         R, J = rp.residual(Xr, float(w))[:2]

@@ -60,7 +60,7 @@ def landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
             X0 = Xs[i0] + t * (Xs[i1] - Xs[i0])
             fun = lambda x: problem.residual(problem.expand(x), w)[:2]
             res = newton(fun, problem.unknowns(X0), scale=xscale, r_scale=r_scale,
-                         blocks=problem.harmonic_blocks())
+                         blocks=problem.solver_structure())
             X = problem.expand(res.x) if res.converged else None
             if X is not None and not point_is_stable(problem, X, w, stability_options):
                 X = None

@@ -97,7 +97,7 @@ def newton(fun, x0, *, scale=None, r_scale=1.0, tol=1e-10, max_iter=30, linear_s
     x = np.array(x0, dtype=float)
     S = np.ones_like(x) if scale is None else np.asarray(scale, dtype=float)
     if linear_solve is None:
-        linear_solve = make_solver(x.size, blocks)
+        linear_solve = make_solver(x.size, blocks, scale=S)
     R, J = fun(x)
     r = float(np.linalg.norm(R))
     target = tol * max(r_scale, 1e-300)

@@ -27,10 +27,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from continuation.linsolve import Structure
 from elements.base import rest_tangents
 
 from hbm.balance.aft import NonlinearForces
 from hbm.balance.energy import EnergyBalance, work
+from hbm.balance.stuck_inverse import StuckInverse
 from hbm.analyses.modal_hill import ModalData
 
 
@@ -94,6 +96,15 @@ class HarmonicBalance:
         h = self.basis.h_of_row
         edges = np.flatnonzero(np.r_[True, h[1:] != h[:-1], True])
         return [(int(a) * nf, int(b) * nf, bool(h[a] > 0)) for a, b in zip(edges[:-1], edges[1:])]
+
+    def solver_structure(self) -> Structure:
+        """:meth:`harmonic_blocks` and, on a condensed model in the Woodbury form, the inverse
+        of the Jacobian with every contact stuck (:mod:`hbm.balance.stuck_inverse`), for the
+        Newton solves (:func:`continuation.linsolve.make_solver`)."""
+        builder = getattr(self.linear, "_builder", None)
+        if getattr(builder, "strategy", None) == "woodbury" and not hasattr(self, "_stuck_inverse"):
+            self._stuck_inverse = StuckInverse(self.linear, self.stuck_stiffness())
+        return Structure(self.harmonic_blocks(), getattr(self, "_stuck_inverse", None))
 
     # ------------------------------------------------------------------ residual
     def residual(self, X: np.ndarray, w: float):
