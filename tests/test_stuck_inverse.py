@@ -100,3 +100,29 @@ def test_frf_with_the_stuck_inverse_equals_the_direct_path(patch, monkeypatch):
     ref = frf(case, stability=False, error_estimate=False)
     near = [int(np.argmin(np.abs(ref.freq_hz - f))) for f in new.freq_hz]
     _same_frf(case, SimpleNamespace(status=ref.status, freq_hz=ref.freq_hz[near], X=ref.X[near]), new)
+
+
+def test_hill_system_through_the_stuck_stiffness_equals_the_whole_solve(patch, monkeypatch):
+    """Hill's modal system (hbm.analyses.modal_hill) formed through the stuck stiffness
+    (a system of the slipping rows only; none where every contact sticks) equals the whole
+    system's (every row of ``I + R J_nl``), to 1e-10, at points where all 16 contacts stick,
+    where some slip and where most do."""
+    import hbm.analyses.modal_hill as mh
+    from hbm.analyses.hill_system import HillSystem
+    from hbm.analyses.modal_hill import modal_hill_system
+    from hbm.analyses.response import frf
+    case, problem = patch
+    res = frf(case, stability=False, error_estimate=False)
+    picks = [int(np.argmax(res.stuck)), int(np.argmin(np.abs(res.stuck - 8))), int(np.argmin(res.stuck))]
+    assert res.stuck[picks[0]] == 16 and res.stuck[picks[2]] < 4 and 0 < res.stuck[picks[1]] < 16
+    hs = HillSystem(problem)
+    modal = problem.modal_data()
+    assert modal.K_ref is not None and np.any(modal.K_ref)
+    for i in picks:
+        w = 2 * np.pi * res.freq_hz[i]
+        J_nl = problem.nonlinear_jacobian(res.X[i], w, hs._nl)
+        monkeypatch.setattr(mh, "WHOLE_SHARE", 1.0)              # the slipping rows' system
+        Jr = modal_hill_system(modal, J_nl, hs.basis, w)[0]
+        monkeypatch.setattr(mh, "WHOLE_SHARE", -1.0)             # the whole system
+        J0 = modal_hill_system(modal, J_nl, hs.basis, w)[0]
+        assert np.abs(Jr - J0).max() <= 1e-10 * np.abs(J0).max()

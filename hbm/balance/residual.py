@@ -203,8 +203,10 @@ class HarmonicBalance:
         return self.nl.dofs[self._nl_free]
 
     def modal_data(self) -> ModalData:
-        """Modes of the linear part seen from :meth:`modal_rows` (:mod:`hbm.analyses.modal_hill`)."""
-        return self.linear.modal_data(self.modal_rows())
+        """Modes of the linear part seen from :meth:`modal_rows`, with the elements' stiffness
+        at rest there (:mod:`hbm.analyses.modal_hill`)."""
+        rows = self.modal_rows()
+        return self.linear.modal_data(rows)._replace(K_ref=self.stuck_stiffness()[np.ix_(rows, rows)])
 
     def energy_balance(self, X: np.ndarray, w: float) -> EnergyBalance:
         """Work per period of the excitation, the viscous and the nonlinear forces (:mod:`hbm.balance.energy`)."""
