@@ -63,6 +63,7 @@ from .base import Element, LawSpec, principal_reversal
 from .keys import coordinate_rows, require_keys, positive, non_negative, finite
 from .friction3d import Friction3D
 from .hertz import hertz_contact
+from .laws.friction3d import n_states
 from .laws.registry import FRICTION3D
 
 
@@ -257,7 +258,7 @@ class Brush(Element):
             R[:nt, :nt] = np.eye(nt)
             R[nt] = c
             params = np.array([w * self.kt, w * self.kn, self.mu, w * p, nt], dtype=float)
-            spec = LawSpec(FRICTION3D, params, 2 * nt + 1, Friction3D.closure, Friction3D.start_rule,
+            spec = LawSpec(FRICTION3D, params, n_states(nt), Friction3D.closure, Friction3D.start_rule,
                            nt + 1, self.max_passes, self.closure_tol, False)
             parts.append((R @ self._T, spec))
         return parts

@@ -7,6 +7,7 @@ import numpy as np
 from .base import Element
 from .keys import coordinate_rows, require_keys, finite, positive, non_negative
 from .law_march import START_PRINCIPAL, CLOSE_NEWTON
+from .laws.friction3d import n_states
 from .laws.registry import FRICTION3D
 
 
@@ -42,7 +43,8 @@ class Friction3D(Element):
     ``N0 - kn g`` (``laws/friction3d.py``).  The tangential force obeys Coulomb's law with a
     circular limit ``mu N`` and a stick stiffness ``kt``.
 
-    State layout (``nt`` = 1 or 2 tangential directions): ``[f_t (nt), f_n, u_t,prev (nt)]``.
+    State layout (``nt`` = 1 or 2 tangential directions): ``[f_t (nt), f_n, u_t,prev (nt), N_p]``
+    (:mod:`elements.laws.friction3d`).
 
     Start of the march (``start_index``): the sample where the tangential motion reverses
     along its principal direction (argmax of the projection of the centred ``u_t`` on the
@@ -84,7 +86,7 @@ class Friction3D(Element):
         n_gap = non_negative("normal_preload", normal_preload) - kn * self.gap
         params = np.array([positive("kt", kt), kn, non_negative("mu", mu), n_gap, float(nt)])
         super().__init__(G, params, name)
-        self.n_state = 2 * nt + 1
+        self.n_state = n_states(nt)
         self.coord_names = ("t1", "t2", "n") if nt == 2 else ("t1", "n")
 
     @classmethod

@@ -225,7 +225,8 @@ def test_variable_normal_load_2d_against_time_march():
 
 
 def test_separation_forces():
-    """Open samples: f_t = 0 and f_n = -N0 exactly; re-contact re-sticks unloaded."""
+    """Open samples: f_t = 0 and f_n = -N0 exactly; re-contact re-sticks unloaded, at the
+    instant between the samples where the normal load crosses zero."""
     n0, n = 0.1, 128
     th = 2 * np.pi * np.arange(n) / n
     el = make(2, n0=n0)
@@ -240,12 +241,37 @@ def test_separation_forces():
     assert summ["open_fraction"] == open_.mean()
     assert summ["normal_load_min"] == 0.0
     np.testing.assert_allclose(summ["normal_load_max"], n0 + KN, rtol=1e-12)
-    # first closed sample after the gap: trial force kt (u_j - u_{j-1}) from zero
+    # first closed sample after the gap: trial force kt (1 - theta) (u_j - u_{j-1}) from zero
     j = next(j for j in range(n) if open_[j - 1] and not open_[j])
-    trial = KT * (z[j, :2] - z[j - 1, :2])
+    Np, Nj = n0 + KN * z[j - 1, 2], n0 + KN * z[j, 2]
+    theta = Np / (Np - Nj)
+    assert 0.0 < theta < 1.0
+    trial = KT * (1.0 - theta) * (z[j, :2] - z[j - 1, :2])
     limit = MU * (n0 + KN * z[j, 2])
     expect = trial if np.linalg.norm(trial) <= limit else limit * trial / np.linalg.norm(trial)
     np.testing.assert_allclose(f[j, :2], expect, rtol=1e-13)
+
+
+def test_forces_are_continuous_as_re_contact_crosses_a_sample():
+    """The balance must be continuous in the unknowns: as the mean normal approach moves the
+    re-contact instant across samples, the force harmonics change in proportion (the largest
+    increment over a fine grid within 5x the median one).  Re-sticking at the last open
+    sample made them jump by ``kt`` times one sample's tangential motion (with a large mu the
+    contact sticks for most of the closed stretch, which keeps the jump)."""
+    el = make(1, mu=20.0, n0=0.1)
+    X = np.zeros((BASIS.n_coef, 2))
+    X[BASIS.row_of(1, "c"), 0], X[BASIS.row_of(1, "s"), 0] = 0.4, 0.3
+    X[BASIS.row_of(1, "c"), 1] = 0.5
+    means = np.linspace(0.0, 0.25, 501)        # the open stretch shrinks by several samples
+    F, opened = [], []
+    for m in means:
+        X[BASIS.row_of(0, "c"), 1] = m
+        Fm, _, f, z = coeff_march(el, BASIS, X)
+        F.append(Fm[:, 0])
+        opened.append(el.summary(f, z)["open_fraction"])
+    steps = np.linalg.norm(np.diff(np.array(F), axis=0), axis=1)
+    assert len(set(opened)) >= 4                           # re-contact crossed samples
+    assert steps.max() <= 5.0 * np.median(steps), (steps.max(), np.median(steps))
 
 
 def test_rest_is_force_free_and_init():
@@ -253,7 +279,7 @@ def test_rest_is_force_free_and_init():
     z = np.zeros((16, 3))
     f, _ = run(el, z)
     assert np.all(f == 0.0)
-    assert el.needs_mean and not el.velocity and el.n_state == 5
+    assert el.needs_mean and not el.velocity and el.n_state == 6
     np.testing.assert_array_equal(el.linear_stiffness(), np.diag([KT, KT, KN]))
 
 
@@ -263,12 +289,12 @@ def test_from_spec_keys_and_validation():
     spec = {"type": "friction3d", "dofs": {"t1": [3, 0], "t2": [4, 1], "n": [5, 2]},
             "kt": 1e6, "kn": 2e6, "mu": 0.5, "normal_preload": 100.0, "name": "c1"}
     el = cls.from_spec(spec, 6)
-    assert el.n_local == 3 and el.name == "c1" and el.n_state == 5
+    assert el.n_local == 3 and el.name == "c1" and el.n_state == 6
     G = np.zeros((3, 6))
     G[0, 3], G[0, 0], G[1, 4], G[1, 1], G[2, 5], G[2, 2] = 1, -1, 1, -1, 1, -1
     np.testing.assert_array_equal(el.gather, G)
     el2 = cls.from_spec({**spec, "dofs": {"t1": "a", "n": ["b"]}}, 6, dof_index={"a": 1, "b": 2})
-    assert el2.n_local == 2 and el2.coord_names == ("t1", "n") and el2.n_state == 3
+    assert el2.n_local == 2 and el2.coord_names == ("t1", "n") and el2.n_state == 4
     np.testing.assert_array_equal(el2.gather[:, :3], [[0, 1, 0], [0, 0, 1]])
     with pytest.raises(ValueError, match="'friction'"):
         cls.from_spec({**spec, "friction": 0.3}, 6)

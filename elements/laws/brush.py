@@ -42,6 +42,7 @@ import numba as nb
 import numpy as np
 
 from ..closure import march_newton
+from .friction3d import n_states
 from .registry import FRICTION3D
 
 
@@ -79,7 +80,7 @@ def brush_march(kt, kn, mu, nt, pre, weight, coef, z, dz, start, max_passes, tol
     """
     N, nl = z.shape
     P = dz.shape[2]
-    ns = 2 * nt + 1
+    ns = n_states(nt)
     f = np.zeros((N, nl))
     df = np.zeros((N, nl, P))
     Kst = np.zeros((nl, nl))

@@ -25,22 +25,46 @@ Tangential law: an incremental return mapping with a circular slip limit ``mu N`
           0 & N = 0 \ \text{(open: the slider follows the contact point)} \end{cases}
 
 After an open step ``f_prev = 0`` and ``u_{t,prev}`` is the current position, so the contact
-re-sticks unloaded at re-contact.
+re-sticks unloaded at re-contact.  The instant of re-contact is placed between the samples:
+with the normal load's trial values ``N_p = N_0 + k_n u_{n,prev} <= 0`` before and
+``N > 0`` now, the load crosses zero at the share ``theta = N_p / (N_p - N)`` of the step,
+where the slider sits at ``u_{t,prev} + theta (u_t - u_{t,prev})``, so
 
-State ``s = [f_t (nt), f_n, u_{t,prev} (nt)]`` (``ns = 2 nt + 1``); the first ``nt + 1``
-entries are the element forces in the order of the coordinates.
+.. math::
+
+    f^{tr} = f_{prev} + g\, k_t (u_t - u_{t,prev}), \qquad g = 1 - \theta
+
+(``g = 1`` when the previous sample was closed).  Without it the slider re-stuck at the last
+open sample, and the stuck tangential force of the whole closed stretch jumped by
+``k_t`` times one sample's tangential motion whenever the re-contact crossed a sample: the
+balance was discontinuous in the unknowns, and Newton stalled at a residual of 1e-8 to 1e-2
+of the force on separating contacts.
+
+State ``s = [f_t (nt), f_n, u_{t,prev} (nt), N_p]`` (``ns = 2 nt + 2``, :func:`n_states`); the
+first ``nt + 1`` entries are the element forces in the order of the coordinates, the last is
+the trial normal load ``N_0 + k_n u_n`` of the sample.
 
 Exact Jacobians.  With ``d = f^{tr}/|f^{tr}|`` and ``M = (mu N / |f^{tr}|)(I - d d^T)``:
 stick ``df_t/df_prev = I``, ``df_t/du_prev = -kt I``, ``df_t/du_t = kt I``; slip
 ``df_t/df_prev = M``, ``df_t/du_prev = -kt M``, ``df_t/du_t = kt M``,
 ``df_t/du_n = mu kn d`` (tangential-normal coupling); open: all tangential derivatives zero.
-``df_n/du_n = kn`` while closed, 0 while open; ``du_prev/du_t = I`` always.
+``df_n/du_n = kn`` while closed, 0 while open; ``du_prev/du_t = I``, ``dN_p/du_n = kn`` always.
+At re-contact the ``k_t`` terms carry ``g``, and ``df^{tr}/dN_p = -k_t (u_t - u_{t,prev})
+d theta / d N_p``, ``df^{tr}/du_n = -k_t (u_t - u_{t,prev}) k_n d theta / d N``, with
+``d theta / d N_p = -N / (N_p - N)^2`` and ``d theta / d N = N_p / (N_p - N)^2``, both through
+``J``.
 """
 from __future__ import annotations
 
 import math
 
 import numba as nb
+
+
+@nb.njit(cache=True)
+def n_states(nt):
+    """State size of the law with ``nt`` tangential directions (module doc)."""
+    return 2 * nt + 2
 
 
 @nb.njit(cache=True)
@@ -59,15 +83,17 @@ def _radial_return(limit, t0, t1):
 
 
 @nb.njit(cache=True)
-def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, with_A):
+def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, with_A, g, e0, e1, c0, c1):
     """Tangential forces into ``s_new`` and their derivatives (module doc) into ``A``
-    (if ``with_A``: ``df_t/df_prev = J``, ``df_t/du_prev = -kt J``) and ``B``
-    (``df_t/du_t = kt J``, ``df_t/du_n = mu kn d``), ``J = r (I - d d^T)`` or ``I``."""
+    (if ``with_A``: ``df_t/df_prev = J``, ``df_t/du_prev = -g kt J``, ``df_t/dN_p = J e``) and
+    ``B`` (``df_t/du_t = g kt J``, ``df_t/du_n = mu kn d + J c``), ``J = r (I - d d^T)`` or
+    ``I``; ``e``, ``c``: the trial force's derivatives by ``N_p`` and ``u_n`` at re-contact."""
     s_new[0] = f0
     if nt == 2:
         s_new[1] = f1
     for a in range(nt):
         da = d0 if a == 0 else d1
+        je, jc = 0.0, 0.0
         for b in range(nt):
             db = d0 if b == 0 else d1
             if slipping:
@@ -76,16 +102,20 @@ def _write_tangential(kt, mu, kn, nt, w0, f0, f1, r, d0, d1, slipping, s_new, A,
                 J = 1.0 if a == b else 0.0
             if with_A:
                 A[a, b] = J
-                A[a, w0 + b] = -kt * J
-            B[a, b] = kt * J
-        B[a, nt] = mu * kn * da if slipping else 0.0
+                A[a, w0 + b] = -g * kt * J
+            B[a, b] = g * kt * J
+            je += J * (e0 if b == 0 else e1)
+            jc += J * (c0 if b == 0 else c1)
+        if with_A:
+            A[a, 2 * nt + 1] = je
+        B[a, nt] = (mu * kn * da if slipping else 0.0) + jc
 
 
 @nb.njit(cache=True)
 def _normal_and_slider(p, z, s_new, B):
-    """Slider positions ``u_t,prev = u_t`` and the normal force into ``s_new`` with their
-    derivatives in ``B`` (zeroed first); returns the normal load ``N`` (<= 0: open, then the
-    tangential forces are zero too)."""
+    """Slider positions ``u_t,prev = u_t``, the normal force and the trial normal load ``N_p``
+    into ``s_new`` with their derivatives in ``B`` (zeroed first); returns the normal load
+    ``N`` (<= 0: open, then the tangential forces are zero too)."""
     kn = p[1]
     N0 = p[3]
     nt = int(p[4])
@@ -97,6 +127,8 @@ def _normal_and_slider(p, z, s_new, B):
         s_new[w0 + a] = z[a]
         B[w0 + a, a] = 1.0
     Nload = N0 + kn * z[nt]
+    s_new[2 * nt + 1] = Nload
+    B[2 * nt + 1, nt] = kn
     if Nload <= 0.0:
         for a in range(nt):
             s_new[a] = 0.0
@@ -116,13 +148,21 @@ def friction3d_step(p, s, z, s_new, A, B):
     for i in range(A.shape[0]):      # explicit loops: a slice fill costs more per sample
         for k in range(A.shape[1]):
             A[i, k] = 0.0
+    Np = s[2 * nt + 1]
     Nload = _normal_and_slider(p, z, s_new, B)
     if Nload <= 0.0:
         return
-    t0 = s[0] + kt * (z[0] - s[w0])
-    t1 = s[1] + kt * (z[1] - s[w0 + 1]) if nt == 2 else 0.0
-    f0, f1, r, d0, d1, slipping = _radial_return(p[2] * Nload, t0, t1)
-    _write_tangential(kt, p[2], p[1], nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, True)
+    g, dth_p, dth_n = 1.0, 0.0, 0.0
+    if Np <= 0.0:                      # re-contact within the step (module doc)
+        q = Np - Nload
+        g = 1.0 - Np / q
+        dth_p, dth_n = -Nload / (q * q), Np / (q * q) * p[1]
+    v0 = z[0] - s[w0]
+    v1 = z[1] - s[w0 + 1] if nt == 2 else 0.0
+    f0, f1, r, d0, d1, slipping = _radial_return(p[2] * Nload, s[0] + g * kt * v0,
+                                                 s[1] + g * kt * v1 if nt == 2 else 0.0)
+    _write_tangential(kt, p[2], p[1], nt, w0, f0, f1, r, d0, d1, slipping, s_new, A, B, True, g,
+                      -kt * v0 * dth_p, -kt * v1 * dth_p, -kt * v0 * dth_n, -kt * v1 * dth_n)
 
 
 @nb.njit(cache=True, inline="always")
@@ -139,7 +179,8 @@ def friction3d_init(p, z0, s0, C0):
         return
     t1 = kt * z0[1] if nt == 2 else 0.0
     f0, f1, r, d0, d1, slipping = _radial_return(p[2] * Nload, kt * z0[0], t1)
-    _write_tangential(kt, p[2], p[1], nt, nt + 1, f0, f1, r, d0, d1, slipping, s0, C0, C0, False)
+    _write_tangential(kt, p[2], p[1], nt, nt + 1, f0, f1, r, d0, d1, slipping, s0, C0, C0, False,
+                      1.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @nb.njit(cache=True, inline="always")
