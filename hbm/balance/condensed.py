@@ -45,6 +45,7 @@ from hbm.balance.condensed_kernels import assemble
 from hbm.balance.condensed_linear import LinearBuilder, LinearPart
 from hbm.balance.contact_coordinates import contact_coordinates, regathered
 from hbm.balance.fourier import FourierBasis
+from hbm.balance.stuck_inverse import StuckInverse
 from hbm.analyses.modal_hill import ModalData
 from hbm.model.condensed_model import condense
 from hbm.model.reduction import ReducedModel
@@ -187,7 +188,27 @@ class CondensedLinear:
         ``Xc = Re Y``, ``Xs = Re(i Y) = -Im Y``."""
         return (self._to_r @ Y).real
 
+    def to_complex(self, x: np.ndarray) -> np.ndarray:
+        """Unknown vector (n_u,) -> complex amplitudes ``X_c - i X_s`` per harmonic (n_h, n_c)."""
+        return self._complex(x.reshape(self.basis.n_coef, self.n_dof))
+
+    def to_real(self, Y: np.ndarray) -> np.ndarray:
+        """Complex amplitudes per harmonic (n_h, n_c) -> unknown vector (n_u,)."""
+        return self._real(Y).reshape(-1)
+
     # ------------------------------------------------------------------ linear part
+    @property
+    def last_frequency(self) -> float | None:
+        """The frequency of the linear part last built (:meth:`at`), or None."""
+        return self._last[0]
+
+    def stuck_inverse(self, Ks: np.ndarray) -> StuckInverse | None:
+        """The approximate inverse of the balance's Jacobian with the elements' rest stiffness
+        ``Ks`` (n_c, n_c) (:mod:`hbm.balance.stuck_inverse`); None unless the linear part is
+        in the Woodbury form."""
+        parts = self._builder.woodbury_parts()
+        return None if parts is None else StuckInverse(*parts, Ks, self)
+
     def at(self, w: float) -> LinearPart:
         """The linear part at ``w`` (:class:`hbm.balance.condensed_linear.LinearPart`); the last
         frequency's is kept."""

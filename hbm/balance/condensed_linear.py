@@ -146,6 +146,13 @@ class LinearBuilder:
         self._S = self.phi[:self.nc].T @ self._B                     # (m, m)
         return True
 
+    def woodbury_parts(self):
+        """``(R_cc^{-1}, B, w -> D(h w) + S)`` of the Woodbury form (:mod:`hbm.balance.stuck_inverse`);
+        None in the other strategies."""
+        if self.strategy != "woodbury":
+            return None
+        return self._Rinv, self._B, lambda w: self._modal(self.hs * w)[0] + self._S
+
     # ------------------------------------------------------------------ pieces
     def _modal(self, Ws):
         """``D(W)`` and ``D'(W)`` per ``W``, (n_W, m, m) complex."""

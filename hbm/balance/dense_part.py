@@ -165,6 +165,10 @@ class DenseLinear:
         R[:] = (ZX - self.Fex + Fn).reshape(-1)[fi]
         dRw[:] = (dZX + dFw).reshape(-1)[fi]
 
+    def stuck_inverse(self, Ks: np.ndarray) -> None:
+        """No approximate inverse is offered (the dense solves factor the whole Jacobian)."""
+        return None
+
     def work_resolution(self, X: np.ndarray, w: float) -> float:
         """0: :meth:`work` uses the residual's own matrices, so only round-off separates them
         (compare :meth:`hbm.balance.condensed.CondensedLinear.work_resolution`)."""

@@ -32,7 +32,6 @@ from elements.base import rest_tangents
 
 from hbm.balance.aft import NonlinearForces
 from hbm.balance.energy import EnergyBalance, work
-from hbm.balance.stuck_inverse import StuckInverse
 from hbm.analyses.modal_hill import ModalData
 
 
@@ -63,6 +62,8 @@ class HarmonicBalance:
         k = (np.arange(nco)[:, None] * nn + np.flatnonzero(self._nl_free)[None, :]).ravel()
         u = (np.arange(nco)[:, None] * free.size + np.searchsorted(free, d[self._nl_free])[None, :]).ravel()
         self._k, self._u = k, u           # nonlinear Jacobian entries on free coordinates -> unknowns
+        # the Newton solves' approximate inverse (every contact stuck), when the linear part offers one
+        self._stuck_inverse = linear.stuck_inverse(self.stuck_stiffness()) if nl.n_nl else None
 
     # ------------------------------------------------------------------ unknowns
     @property
@@ -101,10 +102,7 @@ class HarmonicBalance:
         """:meth:`harmonic_blocks` and, on a condensed model in the Woodbury form, the inverse
         of the Jacobian with every contact stuck (:mod:`hbm.balance.stuck_inverse`), for the
         Newton solves (:func:`continuation.linsolve.make_solver`)."""
-        builder = getattr(self.linear, "_builder", None)
-        if getattr(builder, "strategy", None) == "woodbury" and not hasattr(self, "_stuck_inverse"):
-            self._stuck_inverse = StuckInverse(self.linear, self.stuck_stiffness())
-        return Structure(self.harmonic_blocks(), getattr(self, "_stuck_inverse", None))
+        return Structure(self.harmonic_blocks(), self._stuck_inverse)
 
     # ------------------------------------------------------------------ residual
     def residual(self, X: np.ndarray, w: float):

@@ -26,37 +26,39 @@ class StuckInverse:
 
     Parameters
     ----------
-    linear : hbm.balance.condensed.CondensedLinear
-        With the ``woodbury`` strategy.
+    Rinv, B : ndarray, shape (n_c, n_c), (n_c, m)
+        ``R_cc^{-1}`` and ``R_cc^{-1} Phi_c`` of the Woodbury form.
+    modal : callable
+        ``w -> M_h = D(h w) + S`` per harmonic, (n_h, m, m) complex.
     Ks : ndarray, shape (n_c, n_c)
         Stiffness of the elements at rest.
+    linear : hbm.balance.condensed.CondensedLinear
+        For the frequency last built (``last_frequency``) and the complex form of the
+        unknowns (``to_complex``, ``to_real``).
     """
 
-    def __init__(self, linear, Ks: np.ndarray):
-        b = linear._builder
-        self.linear, self.builder = linear, b
-        self.Qinv = np.linalg.inv(b._Rinv + Ks)                # (n_c, n_c)
-        self.E = self.Qinv @ b._B                               # (n_c, m)
-        self.T = b._B.T @ self.E                                # (m, m)
+    def __init__(self, Rinv: np.ndarray, B: np.ndarray, modal, Ks: np.ndarray, linear):
+        self.Qinv = np.linalg.inv(Rinv + Ks)                   # (n_c, n_c)
+        self.E = self.Qinv @ B                                  # (n_c, m)
+        self.T = B.T @ self.E                                   # (m, m)
+        self.modal, self.linear = modal, linear
         self._w, self._Minv = None, None
 
     def __call__(self):
         """The approximate inverse at the frequency of the linear part last built, as
         ``v (n_u,) -> y (n_u,)``; None before any was built."""
-        w = self.linear._last[0]
+        w = self.linear.last_frequency
         if w is None:
             return None
         if w != self._w:
-            D, _ = self.builder._modal(self.builder.hs * w)
-            self._Minv = np.linalg.inv(D + self.builder._S - self.T)    # (n_h, m, m)
+            self._Minv = np.linalg.inv(self.modal(w) - self.T)          # (n_h, m, m)
             self._w = w
         return self._apply
 
     def _apply(self, v: np.ndarray) -> np.ndarray:
-        lin = self.linear
-        V = lin._complex(v.reshape(lin.basis.n_coef, lin.n_dof))        # (n_h, n_c)
+        V = self.linear.to_complex(v)                                    # (n_h, n_c)
         nh = V.shape[0]
         QV = self.Qinv @ np.concatenate((V.real.T, V.imag.T), axis=1)   # (n_c, 2 n_h)
         W = (self._Minv @ (V @ self.E)[:, :, None])[:, :, 0]            # (n_h, m)
         Y = (QV[:, :nh] + 1j * QV[:, nh:]).T + W @ self.E.T
-        return lin._real(Y).reshape(-1)
+        return self.linear.to_real(Y)
