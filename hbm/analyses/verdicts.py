@@ -21,25 +21,43 @@ from hbm.analyses.stability import StabilityOptions
 from hbm.analyses.stability_path import hill_margin, path_stability
 
 
-def path_verdicts(problem, Xs, ws, segments, options):
+def path_verdicts(problem, Xs, ws, segments, options, linear=None):
     """Hill verdicts of every point, segment by segment (:func:`hbm.analyses.stability_path.path_stability`).
+
+    ``linear`` (n_points,) bool, optional: points where every element sticks all period
+    (:func:`hbm.analyses.stuck.linear_points`); their variational equation is one
+    time-invariant linear system, so the first such point's spectrum gives the verdict and the
+    largest real part of all of them (the margin ``max Re(lambda) - tol w`` follows ``w``).
 
     Returns
     -------
     stable : ndarray of bool, shape (n_points,)
     margin : ndarray, shape (n_points,)
-        ``max Re(lambda) - tol w`` where a spectrum was computed, NaN elsewhere.
+        ``max Re(lambda) - tol w`` where a spectrum was computed or reused, NaN elsewhere.
+    reused : int
+        Points whose verdict came from another linear point's spectrum.
     """
     opts = options or StabilityOptions()
     hill = HillSystem(problem)
     stable = np.ones(ws.size, dtype=bool)
     margin = np.full(ws.size, np.nan)
+    first = []                                 # (verdict, max Re) of the first linear point
+    reused = 0
+
+    def test(i):
+        nonlocal reused
+        w = float(ws[i])
+        if linear is not None and linear[i] and first:
+            reused += 1
+            return first[0][0], first[0][1] - opts.rel_tol * w
+        verdict, m = hill_margin(*hill(Xs[i], w), hill.basis, w, opts)
+        if linear is not None and linear[i]:
+            first.append((verdict, m + opts.rel_tol * w))
+        return verdict, m
+
     for a, b in segments:
-        def test(k, a=a):
-            w = float(ws[a + k])
-            return hill_margin(*hill(Xs[a + k], w), hill.basis, w, opts)
-        stable[a:b], margin[a:b] = path_stability(test, ws[a:b], opts.max_skip)
-    return stable, margin
+        stable[a:b], margin[a:b] = path_stability(lambda k, a=a: test(a + k), ws[a:b], opts.max_skip)
+    return stable, margin, reused
 
 
 def landing_solver(problem, Xs, freq_hz, xscale, r_scale, stability_options):
