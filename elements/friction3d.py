@@ -155,17 +155,21 @@ class Friction3D(Element):
             ``normal_load_min``, ``normal_load_max`` (N over the period), ``open_fraction``
             (fraction of samples with ``N = 0``), ``slip_fraction`` (fraction of samples whose
             step slipped: trial force outside ``mu N``, recomputed exactly from the previous
-            sample), ``dissipation`` (work of the friction force on the slider per period,
+            sample, re-contact between the samples included), ``dissipation`` (work of the friction force on the slider per period,
             ``sum f_t . (w_j - w_{j-1})`` with the slider position ``w = u_t - f_t / kt``).
         """
         f = np.asarray(f, dtype=float)
         z = np.asarray(z, dtype=float)
         nt = self.n_tangential
         Nload = f[:, nt] + self.normal_preload
-        closed = self.params[3] + self.kn * z[:, nt] > 0.0
+        Ntr = self.params[3] + self.kn * z[:, nt]          # trial normal load per sample
+        closed = Ntr > 0.0
+        Np = np.roll(Ntr, 1)
+        recontact = closed & (Np <= 0.0)                   # re-sticks between the samples
+        g = np.where(recontact, Ntr / np.where(recontact, Ntr - Np, 1.0), 1.0)    # 1 - theta
         ft = f[:, :nt]
         ut = z[:, :nt]
-        trial = np.roll(ft, 1, axis=0) + self.kt * (ut - np.roll(ut, 1, axis=0))
+        trial = np.roll(ft, 1, axis=0) + self.kt * g[:, None] * (ut - np.roll(ut, 1, axis=0))
         slipping = closed & (np.linalg.norm(trial, axis=1) > self.mu * Nload)
         w = ut - ft / self.kt
         dissipation = float(np.sum(ft * (w - np.roll(w, 1, axis=0))))

@@ -252,6 +252,21 @@ def test_separation_forces():
     np.testing.assert_allclose(f[j, :2], expect, rtol=1e-13)
 
 
+def test_summary_counts_a_re_contact_step_by_the_law_s_own_trial_force():
+    """Re-contact a third of the way through a step (N_p = -0.1, N = 0.2): the law's trial
+    force is kt (2/3) du = 0.08, inside mu N = 0.1, so the contact re-sticks; the summary's
+    slip count recomputes that trial (kt du = 0.12 would count a slip)."""
+    el = make(1, kt=1.0, kn=2.0, mu=0.5, n0=0.1)
+    n = 16
+    zn = np.where(np.arange(n) < 8, -0.1, 0.05)                 # open, then closed from sample 8
+    zt = np.where((np.arange(n) >= 4) & (np.arange(n) < 8), -0.12, 0.0)   # moves while open
+    z = np.stack([zt, zn], axis=1)
+    f, _ = run(el, z)
+    np.testing.assert_allclose(f[8:, 0], 0.08, rtol=1e-14)
+    summ = el.summary(f, z)
+    assert summ["open_fraction"] == 0.5 and summ["slip_fraction"] == 0.0
+
+
 def test_forces_are_continuous_as_re_contact_crosses_a_sample():
     """The balance must be continuous in the unknowns: as the mean normal approach moves the
     re-contact instant across samples, the force harmonics change in proportion (the largest
