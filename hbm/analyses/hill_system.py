@@ -54,12 +54,33 @@ class HillSystem:
     def __call__(self, X: np.ndarray, w: float):
         """``(J, M, C)`` of the point ``X`` (n_coef, n) at ``w``: shapes (n_coef' m, n_coef' m),
         (m, m), (m, m) with ``n_coef' = 2 H + 1``."""
+        return self.system(self.jacobian(X, w), w)
+
+    def jacobian(self, X: np.ndarray, w: float):
+        """The elements' Jacobian on every harmonic ``0 .. H`` at the point ``X`` (n_coef, n),
+        (n_coef' n_k, n_coef' n_k), or None without elements."""
         if self._rows is not None:
             Xf = np.zeros((self.basis.n_coef, X.shape[1]))
             Xf[self._rows] = X
             X = Xf
-        J_nl = self.problem.nonlinear_jacobian(X, w, self._nl)
+        return self.problem.nonlinear_jacobian(X, w, self._nl)
+
+    def system(self, J_nl, w: float):
+        """``(J, M, C)`` from the elements' Jacobian ``J_nl`` (:meth:`jacobian`)."""
         return modal_hill_system(self.problem.modal_data(), J_nl, self.basis, w)
+
+    def at_rest(self, J_nl) -> bool:
+        """True when ``J_nl`` is exactly the elements' stiffness at rest on every harmonic
+        (every element sticks, closed, for the whole period, evaluated as linear): the
+        variational equation is then the stuck linear system's, the same at every such point."""
+        if J_nl is None:
+            return True
+        Ks = self.problem.modal_data().K_ref
+        nc = Ks.shape[0]
+        nco = J_nl.shape[0] // nc
+        r = np.arange(nco)
+        diag = J_nl.reshape(nco, nc, nco, nc)[r, :, r, :]              # (n_coef', n_k, n_k)
+        return bool(np.all(diag == Ks)) and np.count_nonzero(J_nl) == np.count_nonzero(diag)
 
 
 def _row_parts(basis: FourierBasis):

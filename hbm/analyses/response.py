@@ -32,7 +32,7 @@ from hbm.analyses.problem_setup import (_first_point, _residual_scale, check_bou
                             recover_outputs, resolve_settings, setting_sources, solve_at)
 from hbm.analyses.result import FRFResult, OutputSeries
 from hbm.analyses.stability import StabilityOptions
-from hbm.analyses.stuck import linear_points, stuck_contacts
+from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.verdicts import landing_solver, path_verdicts
 from hbm.analyses.trace import _step_limit, trace_window  # noqa: F401 (_step_limit: tests)
 from hbm.analyses.truncation import MAX_UNKNOWNS, SMALL_ERROR, WARN_ERROR, richer_basis, truncation_errors
@@ -114,9 +114,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
     _closure_warning(settings, pts.unclosed, pts.w)
-    stuck = stuck_contacts(problem, pts_X, np.array(pts_w)) if stability else None
-    stable = _verdicts(problem, pts_X, pts_w, segments, stability_options, settings, progress,
-                       linear_points(problem, stuck)) if stability else None
+    stable = _verdicts(problem, pts_X, pts_w, segments, stability_options, settings, progress) if stability else None
     secs = time.perf_counter() - t0
     Xs = np.array(pts_X) if pts_X else np.zeros((0,) + shape)
     n_out = len(case.analysis.outputs)
@@ -131,8 +129,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
     if error_estimate and Xs.shape[0]:
         outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings)
-    if not stability:
-        stuck = stuck_contacts(problem, Xs, np.array(pts_w))
+    stuck = stuck_contacts(problem, Xs, np.array(pts_w))
     if stuck is not None:
         settings["stuck_points"] = int(np.count_nonzero(stuck))
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
@@ -183,13 +180,13 @@ def stiff_contact_hint(case: Case) -> str:
             f"switches exactly (README, \"Stiff contacts\")")
 
 
-def _verdicts(problem, Xs, ws, segments, stability_options, settings, progress, linear=None):
-    """Hill's verdict (n_points,) of every point (:func:`hbm.analyses.verdicts.path_verdicts`;
-    ``linear``: the points where every element sticks all period); ``settings`` gains the
-    spectra count, the largest growth and, where implausible, a warning."""
+def _verdicts(problem, Xs, ws, segments, stability_options, settings, progress):
+    """Hill's verdict (n_points,) of every point (:func:`hbm.analyses.verdicts.path_verdicts`);
+    ``settings`` gains the spectra count (and how many points at rest shared one), the largest
+    growth and, where implausible, a warning."""
     if progress is not None:
         progress(len(ws), None)
-    stable, margin, reused = path_verdicts(problem, Xs, np.array(ws), segments, stability_options, linear)
+    stable, margin, reused = path_verdicts(problem, Xs, np.array(ws), segments, stability_options)
     settings["stability_spectra"] = int(np.isfinite(margin).sum()) - reused
     settings["stability_spectra_reused"] = reused
     growth = margin / np.array(ws)

@@ -47,17 +47,3 @@ def stuck_contacts(problem, Xs, ws) -> np.ndarray | None:
                 out[k] += 1
     return out
 
-
-def linear_points(problem, stuck) -> np.ndarray | None:
-    """Points where every element sticks (closed) for the whole period, (n_points,) bool, from
-    :func:`stuck_contacts`'s counts ``stuck``; None unless every element is hysteretic.
-
-    There the elements act as their stiffness at rest at every sample (a stuck period is
-    evaluated as linear), so the balance's variational equation is the time-invariant stuck
-    linear system's, the same at every such point: one stability verdict serves them all
-    (:func:`hbm.analyses.verdicts.path_verdicts`).
-    """
-    els = problem.nl.elements
-    if stuck is None or not els or not all(_hysteretic(e) for e in els):
-        return None
-    return np.asarray(stuck) == len(els)

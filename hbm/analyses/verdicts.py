@@ -21,13 +21,14 @@ from hbm.analyses.stability import StabilityOptions
 from hbm.analyses.stability_path import hill_margin, path_stability
 
 
-def path_verdicts(problem, Xs, ws, segments, options, linear=None):
+def path_verdicts(problem, Xs, ws, segments, options):
     """Hill verdicts of every point, segment by segment (:func:`hbm.analyses.stability_path.path_stability`).
 
-    ``linear`` (n_points,) bool, optional: points where every element sticks all period
-    (:func:`hbm.analyses.stuck.linear_points`); their variational equation is one
-    time-invariant linear system, so the first such point's spectrum gives the verdict and the
-    largest real part of all of them (the margin ``max Re(lambda) - tol w`` follows ``w``).
+    At a point whose elements' Jacobian is exactly their stiffness at rest
+    (:meth:`hbm.analyses.hill_system.HillSystem.at_rest`: every element sticks all period)
+    the variational equation is the stuck linear system's, one time-invariant system: the
+    first such point's spectrum gives the verdict and the largest real part of all of them
+    (the margin ``max Re(lambda) - tol w`` follows ``w``).
 
     Returns
     -------
@@ -35,24 +36,26 @@ def path_verdicts(problem, Xs, ws, segments, options, linear=None):
     margin : ndarray, shape (n_points,)
         ``max Re(lambda) - tol w`` where a spectrum was computed or reused, NaN elsewhere.
     reused : int
-        Points whose verdict came from another linear point's spectrum.
+        Points whose verdict came from another point's spectrum at rest.
     """
     opts = options or StabilityOptions()
     hill = HillSystem(problem)
     stable = np.ones(ws.size, dtype=bool)
     margin = np.full(ws.size, np.nan)
-    first = []                                 # (verdict, max Re) of the first linear point
+    rest = []                                  # (verdict, max Re) of the first point at rest
     reused = 0
 
     def test(i):
         nonlocal reused
         w = float(ws[i])
-        if linear is not None and linear[i] and first:
+        J_nl = hill.jacobian(Xs[i], w)
+        at_rest = hill.at_rest(J_nl)
+        if at_rest and rest:
             reused += 1
-            return first[0][0], first[0][1] - opts.rel_tol * w
-        verdict, m = hill_margin(*hill(Xs[i], w), hill.basis, w, opts)
-        if linear is not None and linear[i]:
-            first.append((verdict, m + opts.rel_tol * w))
+            return rest[0][0], rest[0][1] - opts.rel_tol * w
+        verdict, m = hill_margin(*hill.system(J_nl, w), hill.basis, w, opts)
+        if at_rest:
+            rest.append((verdict, m + opts.rel_tol * w))
         return verdict, m
 
     for a, b in segments:
