@@ -40,6 +40,7 @@ class HillSystem:
 
     def __init__(self, problem):
         self.problem = problem
+        self.modal = problem.modal_data()          # the linear part's modes: the same at every point
         b = problem.basis
         full = list(range(0, int(max(b.harmonics)) + 1))
         if list(b.harmonics) == full:
@@ -67,7 +68,7 @@ class HillSystem:
 
     def system(self, J_nl, w: float):
         """``(J, M, C)`` from the elements' Jacobian ``J_nl`` (:meth:`jacobian`)."""
-        return modal_hill_system(self.problem.modal_data(), J_nl, self.basis, w)
+        return modal_hill_system(self.modal, J_nl, self.basis, w)
 
     def at_rest(self, J_nl) -> bool:
         """True when ``J_nl`` is exactly the elements' stiffness at rest on every harmonic
@@ -75,7 +76,7 @@ class HillSystem:
         variational equation is then the stuck linear system's, the same at every such point."""
         if J_nl is None:
             return True
-        Ks = self.problem.modal_data().K_ref
+        Ks = self.modal.K_ref
         nc = Ks.shape[0]
         nco = J_nl.shape[0] // nc
         r = np.arange(nco)
