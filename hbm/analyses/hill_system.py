@@ -77,6 +77,8 @@ class HillSystem:
         if J_nl is None:
             return True
         Ks = self.modal.K_ref
+        if Ks is None:
+            return False
         nc = Ks.shape[0]
         nco = J_nl.shape[0] // nc
         r = np.arange(nco)

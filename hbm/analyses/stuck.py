@@ -46,4 +46,3 @@ def stuck_contacts(problem, Xs, ws) -> np.ndarray | None:
             if s.get("slip_fraction", 1.0) == 0.0 and s.get("open_fraction", 0.0) == 0.0:
                 out[k] += 1
     return out
-
