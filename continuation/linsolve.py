@@ -321,8 +321,9 @@ def make_solver(n: int, blocks=None, scale=None):
     ``blocks`` (``(start, stop)`` ranges of the unknowns, or a :class:`Structure`, whose
     approximate inverse is then tried first on matrices scaled by columns by ``scale``)
     when given and ``n`` reaches :data:`BLOCK_MIN_SIZE`, else :class:`ReusedLU` from
-    :data:`REUSE_MIN_SIZE`, else :func:`direct_solve`.  (Measured on a 16-contact FE patch, 336 unknowns: FRF 2.06 s direct,
-    1.66 s on the blocks; at 84 and 168 unknowns the direct LU is 20 % and 12 % faster.)"""
+    :data:`REUSE_MIN_SIZE`, else :func:`direct_solve`.  (Measured on a 16-contact FE patch,
+    336 unknowns: FRF 2.06 s direct, 1.66 s on the blocks; at 84 and 168 unknowns the direct
+    LU is 20 % and 12 % faster.)"""
     approximate = None
     if isinstance(blocks, Structure):
         blocks, approximate = blocks

@@ -13,7 +13,7 @@ import numpy as np
 
 from hbm.balance.aft import NonlinearForces
 from hbm.balance.fourier import FourierBasis
-from hbm.analyses.modal_hill import modal_hill_system
+from hbm.analyses.modal_hill import modal_hill_system, rest_departures
 from hbm.analyses.stability import HillResult, StabilityOptions, hill_is_stable, hill_stability
 from hbm.balance.transforms import make_transform
 
@@ -77,13 +77,7 @@ class HillSystem:
         if J_nl is None:
             return True
         Ks = self.modal.K_ref
-        if Ks is None:
-            return False
-        nc = Ks.shape[0]
-        nco = J_nl.shape[0] // nc
-        r = np.arange(nco)
-        diag = J_nl.reshape(nco, nc, nco, nc)[r, :, r, :]              # (n_coef', n_k, n_k)
-        return bool(np.all(diag == Ks)) and np.count_nonzero(J_nl) == np.count_nonzero(diag)
+        return Ks is not None and rest_departures(J_nl, Ks, self.basis.n_coef).size == 0
 
 
 def _row_parts(basis: FourierBasis):

@@ -164,10 +164,7 @@ def _element_response(R, J_nl, pc, nco, Ks):
     """
     nc, m = pc.shape
     n = nco * nc
-    nz = J_nl != 0.0                                              # Delta's pattern, not Delta
-    r = np.arange(nco)
-    nz.reshape(nco, nc, nco, nc)[r, :, r, :] = J_nl.reshape(nco, nc, nco, nc)[r, :, r, :] != Ks
-    S = np.flatnonzero(nz.any(axis=1) | nz.any(axis=0))           # (an n x n copy costs more)
+    S = rest_departures(J_nl, Ks, nco)
     if S.size > WHOLE_SHARE * n:             # most rows slip: the whole system is cheaper
         RJ = (R @ J_nl.reshape(nco, nc, n)).reshape(n, n)
         T = np.linalg.solve(np.eye(n) + RJ, _on_every_row(pc, nco))
@@ -194,6 +191,18 @@ def _element_response(R, J_nl, pc, nco, Ks):
     if S.size:
         Y += DS @ T[S]
     return Y.reshape(nco, nc, nco * m)
+
+
+def rest_departures(J_nl: np.ndarray, Ks: np.ndarray, nco: int) -> np.ndarray:
+    """Rows ``S`` (and columns) where ``J_nl`` (n_coef n_c, n_coef n_c) differs from ``Ks``
+    (n_c, n_c) on every coefficient row, i.e. where ``Delta = J_nl - I x Ks`` is not zero;
+    empty when the elements act as their stiffness at rest.  (Found from ``Delta``'s pattern:
+    an ``n x n`` copy costs more.)"""
+    nc = Ks.shape[0]
+    nz = J_nl != 0.0
+    r = np.arange(nco)
+    nz.reshape(nco, nc, nco, nc)[r, :, r, :] = J_nl.reshape(nco, nc, nco, nc)[r, :, r, :] != Ks
+    return np.flatnonzero(nz.any(axis=1) | nz.any(axis=0))
 
 
 def _on_every_row(P: np.ndarray, nco: int) -> np.ndarray:

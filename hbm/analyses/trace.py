@@ -257,7 +257,7 @@ def _fresh_point_past(problem, case, w_from, window, xscale, r_scale):
             continue
         eb = energy_balance(problem, Xr, w_r)
         err = eb.relative_error
-        if not _refused(err, 0.0) or not _refused(err, _resolution(problem, Xr, w_r, eb)):
+        if err <= ENERGY_LIMIT or not _refused(err, _resolution(problem, Xr, w_r, eb)):
             return Xr, itr, w_r
         if k >= len(ladder):
             why = f"the time-domain start's energy balance did not close ({err:.1e})"
