@@ -35,7 +35,7 @@ def test_cli_runs_the_rig_as_documented(tmp_path):
     with open(out / "frf.csv") as fh:
         rows = list(csv.reader(fh))
     assert rows[0] == ["freq_hz", "a1_h1", "a1_max", "a1_err", "a2_h1", "a2_max", "a2_err", "a3_h1", "a3_max",
-                       "a3_err", "stuck_contacts", "stable"]
+                       "a3_err", "stuck_contacts", "H", "stable"]
     data = np.array([[float(v) for v in r[:7]] for r in rows[1:]])
     assert data[0, 0] == pytest.approx(100.0) and data[-1, 0] == pytest.approx(130.0)
     # Ft0 = 0.5 N < pi/4 N: blade 1 runs away at its own resonance (120.9 Hz)

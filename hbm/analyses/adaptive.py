@@ -1,20 +1,25 @@
 r"""Harmonics chosen for a tolerance: ``hbm frf --tol``.
 
-The FRF is traced at the case's harmonics; when the largest estimated truncation error of its
-points (:mod:`hbm.analyses.truncation`) exceeds ``tol``, it is traced again with more harmonics
-(:math:`H \to \lceil 1.5 H \rceil`, keeping an odd-only pattern odd), until the estimate is
-within ``tol`` or ``H_MAX`` is reached.  The harmonics are chosen for the whole window, not per
-point, so the run costs the sum of its attempts; each attempt is listed in
-``settings["adaptive"]`` with its largest estimated error and time.
+The FRF is traced at the case's harmonics and every point's truncation error estimated
+(:mod:`hbm.analyses.truncation`).  When more than ``WHOLE_SHARE`` of the points exceed ``tol``
+the path itself needs more harmonics: it is traced again on the next set
+(:math:`H \to \lceil 1.5 H \rceil`, an odd-only pattern kept odd).  Once most points are within
+``tol``, each point still above it is solved again, alone, on richer harmonics until within
+(:mod:`hbm.analyses.point_harmonics`), so only the stretches that need harmonics pay for them.
+``settings["adaptive"]`` lists every trace (its harmonics, largest estimate, share of points
+above ``tol``, time) and the points refined per harmonic level.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
 import numpy as np
 
 H_MAX = 63
+DEFAULT_TOL = 1e-2    # ``hbm frf`` without --harmonics or --tol: points estimated worse are refined
+WHOLE_SHARE = 0.5     # above this share of points over tol, the whole path is traced again
 
 
 def next_harmonics(h) -> list:
@@ -36,22 +41,50 @@ def _worst(res) -> float:
 
 
 def frf_to_tolerance(case, tol: float, harmonics=None, **kwargs):
-    """:func:`hbm.analyses.response.frf` with harmonics raised until every point's estimated error of the
-    first harmonics is within ``tol`` (module doc); returns the last FRF."""
+    """:func:`hbm.analyses.response.frf` with harmonics raised, for the path and then point by
+    point, until every point's estimated error of the first harmonics is within ``tol``
+    (module doc); returns the FRF."""
+    from hbm.analyses.point_harmonics import over_tolerance, refine_points
     from hbm.analyses.problem_setup import resolve_settings
     from hbm.analyses.response import frf
     if not (tol > 0 and math.isfinite(tol)):
         raise ValueError(f"tol must be a positive number, got {tol!r}")
-    h = list(resolve_settings(case, harmonics)[0])
-    tried = []
+    h, _, lo, hi, _ = resolve_settings(case, harmonics, kwargs.get("samples"), kwargs.get("fmin"),
+                                       kwargs.get("fmax"), kwargs.get("transform"))
+    h, tried, t0 = list(h), [], time.perf_counter()
     while True:
-        t0 = time.perf_counter()
+        t1 = time.perf_counter()
         res = frf(case, harmonics=h, error_estimate=True, **kwargs)
-        worst = _worst(res)
-        tried.append({"H": int(max(h)), "max_error": worst, "seconds": round(time.perf_counter() - t0, 4),
-                      "status": res.status})
-        if worst <= tol or max(h) >= H_MAX or not res.ok or not math.isfinite(worst):
+        share = float(np.mean(over_tolerance(res, tol))) if res.freq_hz.size else 0.0
+        tried.append({"H": int(max(h)), "max_error": _worst(res), "share_above": round(share, 4),
+                      "seconds": round(time.perf_counter() - t1, 4), "status": res.status})
+        if share <= WHOLE_SHARE or max(h) >= H_MAX or not res.ok or not math.isfinite(tried[-1]["max_error"]):
             break
         h = next_harmonics(h)
-    res.settings["adaptive"] = {"tol": tol, "tried": tried, "met": bool(worst <= tol)}
-    return res
+    res, refined = refine_points(case, res, tol, (lo, hi), kwargs.get("transform") or "auto",
+                                 kwargs.get("stability_options"))
+    worst = _worst(res)
+    checked = math.isfinite(worst)      # False: no point's error could be estimated (too large)
+    res.settings["adaptive"] = {"tol": tol, "tried": tried, "points": refined, "checked": checked,
+                                "max_error": worst if checked else None, "met": bool(checked and worst <= tol),
+                                "seconds": round(time.perf_counter() - t0, 4)}
+    _restate_errors(res)
+    return dataclasses.replace(res, solve_seconds=res.settings["adaptive"]["seconds"])
+
+
+def _restate_errors(res) -> None:
+    """``settings["error_estimate"]["max"]`` and the truncation warning after refinement."""
+    from hbm.analyses.truncation import WARN_ERROR
+    est = res.settings.get("error_estimate") or {}
+    if "max" not in est:
+        return
+    for name, o in res.outputs.items():
+        k = int(np.nanargmax(o.err)) if np.isfinite(o.err).any() else 0
+        est["max"][name] = {"error": float(o.err[k]), "freq_hz": float(res.freq_hz[k])}
+    top = max(est["max"].items(), key=lambda kv: kv[1]["error"])
+    if top[1]["error"] <= WARN_ERROR:
+        res.settings.pop("truncation_warning", None)
+    elif res.point_harmonics is not None:
+        res.settings["truncation_warning"] = (
+            f"estimated error of {top[0]} up to {top[1]['error']:.1%} at {top[1]['freq_hz']:.6g} Hz from the "
+            f"harmonic truncation after refining points up to H = {int(res.point_harmonics.max())}")

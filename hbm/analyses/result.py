@@ -71,6 +71,10 @@ class FRFResult:
     stuck: np.ndarray | None = None
     """Hysteretic contacts stuck for the whole period at every point (:mod:`hbm.analyses.stuck`; a
     point with one has a family of periodic solutions), None without such contacts."""
+    point_harmonics: np.ndarray | None = None
+    """Highest harmonic of every point (n_points,) when ``hbm frf --tol`` chose them point by
+    point (:mod:`hbm.analyses.point_harmonics`; ``X`` and ``Y`` are then on the richest basis),
+    else None: every point on ``basis``."""
 
     @property
     def ok(self) -> bool:
@@ -98,6 +102,8 @@ class FRFResult:
         cols.update(self.element_outputs)
         if self.stuck is not None:
             cols["stuck_contacts"] = self.stuck
+        if self.point_harmonics is not None:
+            cols["H"] = self.point_harmonics
         cols["stable"] = (np.full(self.freq_hz.size, np.nan) if self.stable is None
                           else np.asarray(self.stable, dtype=float))
         cols["energy_error"] = self.energy_error

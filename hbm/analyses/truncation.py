@@ -48,15 +48,17 @@ def richer_basis(basis: FourierBasis) -> FourierBasis:
     return FourierBasis(hr, int(n))
 
 
-def embed(X: np.ndarray, basis: FourierBasis, richer: FourierBasis) -> np.ndarray:
-    """Coefficients ``X`` (n_coef, n) of ``basis`` as those of ``richer`` (new harmonics zero)."""
-    out = np.zeros((richer.n_coef, X.shape[1]))
-    for h in basis.harmonics:
-        if h == 0:
-            out[richer.row_of(0)] = X[basis.row_of(0)]
-        else:
-            out[richer.row_of(int(h), "c")] = X[basis.row_of(int(h), "c")]
-            out[richer.row_of(int(h), "s")] = X[basis.row_of(int(h), "s")]
+def embed(X: np.ndarray, basis: FourierBasis, richer: FourierBasis, axis: int = 0) -> np.ndarray:
+    """Coefficients ``X`` of ``basis`` (its rows along ``axis``, e.g. (n_coef, n)) as those of
+    ``richer`` (new harmonics zero); ``richer`` holds every harmonic of ``basis``."""
+    hb, hr = basis.h_of_row, richer.h_of_row
+    rows = np.searchsorted(hr, hb) + (np.arange(hb.size) - np.searchsorted(hb, hb))
+    shape = list(X.shape)
+    shape[axis] = richer.n_coef
+    out = np.zeros(shape)
+    index = [slice(None)] * X.ndim
+    index[axis] = rows
+    out[tuple(index)] = X
     return out
 
 

@@ -76,7 +76,9 @@ def build_parser():
     f.add_argument("--no-stability", dest="stability", action="store_false",
                    help="skip the Hill stability of the points (empty 'stable' column)")
     f.add_argument("--tol", type=_positive_float,
-                   help="raise the harmonics until every point's estimated error of the first harmonic is below TOL")
+                   help="raise the harmonics, for the path and then point by point, until every point's estimated "
+                        "error of the first harmonic is below TOL (column H: each point's harmonics; default "
+                        "1e-2 unless --harmonics is given)")
     _add_analysis_options(f)
     t = sub.add_parser("timesim", help="time-domain reference at one frequency (steady state or transient)")
     t.add_argument("case", help="case file (TOML)")
@@ -133,7 +135,25 @@ def _defaults_note(st) -> str:
     return f" (element defaults: {', '.join(d)})" if d else ""
 
 
+def _print_adaptive(a: dict, explicit: bool) -> None:
+    """What the harmonics' tolerance did: printed when asked for, or when it did anything."""
+    pts = a["points"]
+    if not explicit and len(a["tried"]) == 1 and not pts["levels"]:
+        return
+    if not a["checked"]:
+        print(f"  harmonics for --tol {a['tol']:g}: not checked (no point's error could be estimated)")
+        return
+    steps = " -> ".join(f"H={t['H']} (largest estimate {t['max_error']:.1e}, {t['share_above']:.0%} of points "
+                        f"above, {t['seconds']:.2f} s)" for t in a["tried"])
+    ref = ", ".join(f"{v['points']} at H={v['H']}" for v in pts["levels"]) or "none"
+    print(f"  harmonics for --tol {a['tol']:g}: path traced at {steps}; points refined: {ref} "
+          f"({pts['seconds']:.2f} s)" + ("" if a["met"] else
+                                         f": tolerance NOT met (largest estimate {a['max_error']:.1e}, "
+                                         f"{pts['left_above']} points above, {pts['failed']} refinements failed)"))
+
+
 def cmd_frf(args) -> int:
+    from hbm.analyses.adaptive import DEFAULT_TOL, frf_to_tolerance
     from hbm.analyses.response import frf
     from hbm.interface.report import describe_folds, write_frf
     from hbm.interface.progress import FRFProgress, compile_notice
@@ -146,9 +166,9 @@ def cmd_frf(args) -> int:
     try:
         kw = dict(samples=args.samples, fmin=args.fmin, fmax=args.fmax, transform=args.transform,
                   progress=bar, stability=args.stability)
-        if args.tol is not None:
-            from hbm.analyses.adaptive import frf_to_tolerance
-            res = frf_to_tolerance(case, args.tol, harmonics=args.harmonics, **kw)
+        tol = DEFAULT_TOL if args.tol is None and args.harmonics is None else args.tol
+        if tol is not None:
+            res = frf_to_tolerance(case, tol, harmonics=args.harmonics, **kw)
         else:
             res = frf(case, harmonics=args.harmonics, **kw)
     finally:
@@ -160,9 +180,7 @@ def cmd_frf(args) -> int:
           + _defaults_note(res.settings))
     st = res.settings
     if st.get("adaptive"):
-        a = st["adaptive"]
-        steps = " -> ".join(f"H={t['H']} (largest estimate {t['max_error']:.1e}, {t['seconds']:.2f} s)" for t in a["tried"])
-        print(f"  harmonics for --tol {a['tol']:g}: {steps}" + ("" if a["met"] else ": tolerance NOT met"))
+        _print_adaptive(st["adaptive"], explicit=args.tol is not None)
     if st.get("solver") == "condensed":
         print(f"  condensed solver: {st['n_dof']} DOFs -> {st['contact_coordinates']} contact coordinates, "
               f"{st['modes']} modes (to {st['highest_kept_mode_hz']:.6g} Hz), reduction {st['reduction_seconds']:.3f} s"

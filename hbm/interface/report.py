@@ -4,8 +4,8 @@
 relative error of ``NAME_h1`` from the harmonic truncation, when computed) per DOF output, then one
 column ``NAME`` per element output (a per-period scalar such as ``contact.slip_fraction``), then
 ``stuck_contacts`` (hysteretic contacts stuck for the whole period, :mod:`hbm.analyses.stuck`; absent
-without such contacts), then
-``stable`` (1/0, empty when not computed); rows follow the continuation path.  ``summary.json``
+without such contacts), then ``H`` (the point's highest harmonic, when ``--tol`` chose them point by
+point), then ``stable`` (1/0, empty when not computed); rows follow the continuation path.  ``summary.json``
 adds ``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.analyses.jumps`) when
 the stability was computed.  ``frf.png``: :mod:`hbm.interface.frf_plot`.
 """
@@ -91,8 +91,9 @@ def format_csv(res) -> str:
     has_err = bool(names) and all(getattr(res.outputs[n], "err", None) is not None for n in names)
     keys = ("h1", "max", "err") if has_err else ("h1", "max")
     stuck = getattr(res, "stuck", None)
+    ph = getattr(res, "point_harmonics", None)
     w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in keys] + enames
-               + ([] if stuck is None else ["stuck_contacts"]) + ["stable"])
+               + ([] if stuck is None else ["stuck_contacts"]) + ([] if ph is None else ["H"]) + ["stable"])
     for i, f in enumerate(res.freq_hz):
         row = [f"{f:.10g}"]
         for n in names:
@@ -101,6 +102,8 @@ def format_csv(res) -> str:
         row += [f"{res.element_outputs[n][i]:.10g}" for n in enames]
         if stuck is not None:
             row.append(str(int(stuck[i])))
+        if ph is not None:
+            row.append(str(int(ph[i])))
         row.append("" if res.stable is None else str(int(bool(res.stable[i]))))
         w.writerow(row)
     return buf.getvalue()
