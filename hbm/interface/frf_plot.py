@@ -57,12 +57,15 @@ def _draw_jumps(ax, jumps, scale):
                         arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.5})
 
 
-def _draw_errors(ax, freq, errs, colours):
-    """Estimated relative error of each output's first harmonic, log scale, 1 % marked."""
+def _draw_errors(ax, freq, errs, colours, tol=None):
+    """Estimated relative error of each output's first harmonic, log scale, 1 % marked (and the
+    harmonics' tolerance ``tol`` when the run had one other than 1 %)."""
     for k, (name, e) in enumerate(errs.items()):
         ax.semilogy(freq, np.maximum(np.nan_to_num(e, nan=1e-16), 1e-16), lw=1.0, color=colours[k % len(colours)],
                     label=name)
     ax.axhline(0.01, color="tab:red", lw=0.8, ls="--", label="1 %")
+    if tol is not None and tol != 0.01:
+        ax.axhline(tol, color="tab:green", lw=0.8, ls="--", label=f"--tol {tol:g}")
     ax.set_ylim(bottom=max(1e-8, ax.get_ylim()[0]))
     if all(np.nanmax(np.nan_to_num(e, nan=0.0), initial=0.0) < 1e-8 for e in errs.values()):
         ax.set_ylim(1e-8, 1e-1)
@@ -122,7 +125,8 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
     if errs:
-        _draw_errors(axes[panels.index("err"), 0], res.freq_hz, errs, colours)
+        tol = (res.settings.get("adaptive") or {}).get("tol")
+        _draw_errors(axes[panels.index("err"), 0], res.freq_hz, errs, colours, tol)
     if elem:
         ex = axes[panels.index("elem"), 0]
         for name, v in elem.items():
