@@ -6,6 +6,8 @@ the path itself needs more harmonics: it is traced again on the next set
 (:math:`H \to \lceil 1.5 H \rceil`, an odd-only pattern kept odd).  Once most points are within
 ``tol``, each point still above it is solved again, alone, on richer harmonics until within
 (:mod:`hbm.analyses.point_harmonics`), so only the stretches that need harmonics pay for them.
+Even harmonics that carry nothing at any traced point (a symmetric response) are left out of
+the richer sets (:func:`carried_harmonics`): they follow the odd pattern, at half the unknowns.
 ``settings["adaptive"]`` lists every trace (its harmonics, largest estimate, share of points
 above ``tol``, time) and the points refined per harmonic level.
 """
@@ -35,6 +37,19 @@ def next_harmonics(h) -> list:
     return sorted(set(h) | set(range(top + step, new + 1, step)))
 
 
+def carried_harmonics(res, rel: float = 1e-10) -> list:
+    """The harmonics of ``res`` without its even ones (not the mean) when they carry nothing at
+    any point (every coefficient at most ``rel`` times the largest: a symmetric response), so
+    richer sets follow the odd pattern at half the unknowns; else all of them."""
+    h = [int(x) for x in res.basis.harmonics]
+    even = [x for x in h if x > 0 and x % 2 == 0]
+    if not even or res.X.size == 0:
+        return h
+    rows = np.isin(res.basis.h_of_row, even)
+    top = float(np.abs(res.X).max())
+    return [x for x in h if x not in even] if float(np.abs(res.X[:, rows]).max()) <= rel * top else h
+
+
 def _worst(res) -> float:
     errs = [np.nanmax(o.err) for o in res.outputs.values() if o.err is not None and np.isfinite(o.err).any()]
     return float(max(errs)) if errs else math.inf
@@ -60,12 +75,15 @@ def frf_to_tolerance(case, tol: float, harmonics=None, **kwargs):
                       "seconds": round(time.perf_counter() - t1, 4), "status": res.status})
         if share <= WHOLE_SHARE or max(h) >= H_MAX or not res.ok or not math.isfinite(tried[-1]["max_error"]):
             break
-        h = next_harmonics(h)
+        h = next_harmonics(carried_harmonics(res))
+    start = carried_harmonics(res)
+    dropped = [int(x) for x in res.basis.harmonics if x not in start]
     res, refined = refine_points(case, res, tol, (lo, hi), kwargs.get("transform") or "auto",
-                                 kwargs.get("stability_options"))
+                                 kwargs.get("stability_options"), start)
     worst = _worst(res)
     checked = math.isfinite(worst)      # False: no point's error could be estimated (too large)
     res.settings["adaptive"] = {"tol": tol, "tried": tried, "points": refined, "checked": checked,
+                                "dropped": dropped,
                                 "max_error": worst if checked else None, "met": bool(checked and worst <= tol),
                                 "seconds": round(time.perf_counter() - t0, 4)}
     _restate_errors(res)

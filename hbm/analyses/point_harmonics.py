@@ -128,17 +128,19 @@ def _point_record(case, lv: _Level, X, w, stability_options, with_stability: boo
     return rec
 
 
-def refine_points(case, res, tol: float, window_hz, transform="auto", stability_options=None):
+def refine_points(case, res, tol: float, window_hz, transform="auto", stability_options=None, start=None):
     """``res`` with every point whose estimated error exceeds ``tol`` solved again on richer
     harmonics until within it (module doc).  Returns ``(result, info)``; ``info`` lists the
     levels (highest harmonic, samples, points solved there), the points left above ``tol``, the
-    failed solves and the time taken."""
+    failed solves and the time taken.  ``start``: the harmonics whose richer sets are tried
+    (default: the result's; :func:`hbm.analyses.adaptive.carried_harmonics` leaves out those that
+    carry nothing)."""
     t0 = time.perf_counter()
     todo = [int(i) for i in np.flatnonzero(over_tolerance(res, tol))]
     info = {"levels": [], "left_above": 0, "failed": 0}
     segments = res.settings.get("segments") or [(0, res.freq_hz.size)]
     current = {i: (res.X[i], 2 * np.pi * res.freq_hz[i], res.basis) for i in todo}
-    records, h, stuck_above = {}, list(res.basis.harmonics), []
+    records, h, stuck_above = {}, list(start if start is not None else res.basis.harmonics), []
     while todo and max(h) < H_MAX:
         h = next_harmonics(h)
         N = max(res.basis.n_samples, default_samples(h, case.analysis.samples_factor))
@@ -181,7 +183,8 @@ def _scaled_path(lv: _Level, res, current) -> np.ndarray:
 
 def _merged(res, records: dict):
     """``res`` on the richest basis of ``records``, their points replacing its own."""
-    rb = max((r["basis"] for r in records.values()), key=lambda b: b.n_coef)
+    top = max((r["basis"] for r in records.values()), key=lambda b: b.n_coef)
+    rb = FourierBasis(np.union1d(res.basis.harmonics, top.harmonics), top.n_samples)
     n = res.freq_hz.size
     X, Y = embed(res.X, res.basis, rb, axis=1), embed(res.Y, res.basis, rb, axis=1)
     freq = res.freq_hz.copy()

@@ -48,17 +48,18 @@ def richer_basis(basis: FourierBasis) -> FourierBasis:
     return FourierBasis(hr, int(n))
 
 
-def embed(X: np.ndarray, basis: FourierBasis, richer: FourierBasis, axis: int = 0) -> np.ndarray:
+def embed(X: np.ndarray, basis: FourierBasis, other: FourierBasis, axis: int = 0) -> np.ndarray:
     """Coefficients ``X`` of ``basis`` (its rows along ``axis``, e.g. (n_coef, n)) as those of
-    ``richer`` (new harmonics zero); ``richer`` holds every harmonic of ``basis``."""
-    hb, hr = basis.h_of_row, richer.h_of_row
-    rows = np.searchsorted(hr, hb) + (np.arange(hb.size) - np.searchsorted(hb, hb))
+    ``other``: zero on the harmonics ``basis`` lacks, and those ``other`` lacks left out."""
+    hb, ho = basis.h_of_row, other.h_of_row
+    keep = np.isin(hb, ho)
+    rows = (np.searchsorted(ho, hb) + (np.arange(hb.size) - np.searchsorted(hb, hb)))[keep]
     shape = list(X.shape)
-    shape[axis] = richer.n_coef
+    shape[axis] = other.n_coef
     out = np.zeros(shape)
-    index = [slice(None)] * X.ndim
-    index[axis] = rows
-    out[tuple(index)] = X
+    into, take = [slice(None)] * X.ndim, [slice(None)] * X.ndim
+    into[axis], take[axis] = rows, np.flatnonzero(keep)
+    out[tuple(into)] = X[tuple(take)]
     return out
 
 
