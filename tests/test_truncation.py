@@ -75,6 +75,13 @@ def test_harmonics_beyond_need_are_noted():
     raw = hbm.load_case(ROOT / "rigs" / "sdof_jenkins.toml").raw
     raw["element"][0]["slip_force"] = 1e6                       # stuck: a linear response
     res = hbm.frf(hbm.case_from_dict(raw), harmonics=9, stability=False)
-    assert "H = 9 is more than this response needs" in res.settings["harmonics_note"]
-    res = hbm.frf(hbm.load_case(ROOT / "rigs" / "sdof_jenkins.toml"), stability=False)
-    assert "harmonics_note" not in res.settings
+    assert "H = 9 is more than this response needs; about H = 3" in res.settings["harmonics_note"]
+    case = hbm.load_case(ROOT / "rigs" / "sdof_jenkins.toml")
+    res = hbm.frf(case, stability=False)
+    assert "harmonics_note" not in res.settings                 # H = 7: up to 9e-4
+    # H = 40 (1.2e-5): the note names H = 5, whose estimate is then near 1e-3 as it says
+    res = hbm.frf(case, harmonics=40, stability=False)
+    note = res.settings["harmonics_note"]
+    assert "H = 40 is more than this response needs; about H = 5 would keep them near 0.001" in note
+    res = hbm.frf(case, harmonics=5, stability=False)
+    assert 3e-4 < res.settings["error_estimate"]["max"]["x"]["error"] < 3e-3

@@ -35,7 +35,7 @@ from hbm.analyses.stability import StabilityOptions
 from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.verdicts import landing_solver, path_verdicts
 from hbm.analyses.trace import _step_limit, trace_window  # noqa: F401 (_step_limit: tests)
-from hbm.analyses.truncation import MAX_UNKNOWNS, SMALL_ERROR, WARN_ERROR, richer_basis, truncation_errors
+from hbm.analyses.truncation import MAX_UNKNOWNS, WARN_ERROR, harmonics_note, richer_basis, truncation_errors
 
 __all__ = ["frf", "FRFResult", "OutputSeries", "build_problem", "choose_solver", "output_amplitudes",
            "recover_outputs", "resolve_settings", "solve_at"]
@@ -128,7 +128,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         jumps = _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, stability_options)
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
     if error_estimate and Xs.shape[0]:
-        outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings)
+        outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings, t0)
     stuck = stuck_contacts(problem, Xs, np.array(pts_w))
     if stuck is not None:
         settings["stuck_points"] = int(np.count_nonzero(stuck))
@@ -225,10 +225,11 @@ def _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, 
     return jumps
 
 
-def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
+def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings, t_solve) -> dict:
     """``outputs`` with the truncation error estimate of every point (:mod:`hbm.analyses.truncation`);
     ``settings`` gains ``error_estimate`` (computed, richer H, largest error per output) and,
-    above ``WARN_ERROR``, a ``truncation_warning``."""
+    above ``WARN_ERROR``, a ``truncation_warning``, or far below it a ``harmonics_note`` (the FRF
+    started at ``t_solve``, ``time.perf_counter``)."""
     t0 = time.perf_counter()
     rb = richer_basis(problem.basis)
     info = {"computed": False, "richer_harmonics": int(rb.harmonics.max())}
@@ -249,10 +250,9 @@ def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings) -> dict:
     settings["error_estimate"] = info
     H = int(problem.basis.harmonics.max())
     top = max((v["error"] for v in worst.values()), default=0.0)
-    if H >= 5 and top < SMALL_ERROR:
-        settings["harmonics_note"] = (
-            f"estimated errors stay below {SMALL_ERROR:g} at every point: H = {H} is more than this response "
-            f"needs (the Newton systems grow as H^2 and their factorisations as H^3); try harmonics = {max(3, H // 2)}")
+    note = harmonics_note(H, top, problem.n_unknowns, time.perf_counter() - t_solve)
+    if note:
+        settings["harmonics_note"] = note
     bad = {n: v for n, v in worst.items() if v["error"] > WARN_ERROR}
     if bad:
         n, v = max(bad.items(), key=lambda kv: kv[1]["error"])
