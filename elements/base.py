@@ -229,7 +229,9 @@ def slider_summary(f, u, kt) -> dict:
     f = np.asarray(f, dtype=float)
     u = np.asarray(u, dtype=float)
     w = u - f / kt
-    dw = w - np.roll(w, 1)
+    dw = np.empty_like(w)
+    dw[0] = w[0] - w[-1]
+    np.subtract(w[1:], w[:-1], out=dw[1:])
     tol = 1e-9 * (np.abs(u).max() + np.abs(f).max() / kt)
     return {
         "slip_fraction": float(np.mean(np.abs(dw) > tol)),

@@ -61,7 +61,8 @@ class HarmonicBalance:
         nco, nn = self.basis.n_coef, d.size
         k = (np.arange(nco)[:, None] * nn + np.flatnonzero(self._nl_free)[None, :]).ravel()
         u = (np.arange(nco)[:, None] * free.size + np.searchsorted(free, d[self._nl_free])[None, :]).ravel()
-        self._k, self._u = k, u           # nonlinear Jacobian entries on free coordinates -> unknowns
+        # nonlinear Jacobian entries on free coordinates -> unknowns, as index grids made once
+        self._kk, self._uu = np.ix_(k, k), np.ix_(u, u)
         # the Newton solves' approximate inverse (every contact stuck), when the linear part offers one
         self._stuck_inverse = linear.stuck_inverse(self.stuck_stiffness()) if nl.n_nl else None
 
@@ -154,7 +155,7 @@ class HarmonicBalance:
         else:
             Fd, dFd, dFwd = nl.evaluate(np.ascontiguousarray(X[:, nl.dofs]), w)
             J[...] = 0.0
-            J[np.ix_(self._u, self._u)] = dFd[np.ix_(self._k, self._k)]
+            J[self._uu] = dFd[self._kk]
             Fn, dFw = np.zeros_like(X), np.zeros_like(X)
             Fn[:, nl.dofs], dFw[:, nl.dofs] = Fd, dFwd
         R = np.empty(J.shape[0])
