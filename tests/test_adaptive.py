@@ -76,6 +76,26 @@ def test_refined_points_solve_their_own_harmonics(three_dof_adaptive):
         assert res.outputs["x3"].h1[i] == pytest.approx(np.hypot(y[rc, 0], y[rc + 1, 0]), rel=1e-12)
 
 
+class _Recorder:
+    def __init__(self):
+        self.calls = []
+
+    def __call__(self, n, f):
+        pass
+
+    def refining(self, done, total, top):
+        self.calls.append((done, total, top))
+
+
+def test_refinement_reports_progress_and_keeps_verdicts():
+    rec = _Recorder()
+    res = frf_to_tolerance(three_dof(), 1e-2, progress=rec)
+    assert rec.calls[0] == (0, 18, 11) and rec.calls[-1] == (17, 18, 11)
+    assert res.stable is not None and res.stable.shape == res.freq_hz.shape
+    refined = res.point_harmonics > 7
+    assert refined.sum() == 18 and res.stable[refined].all()       # this chain is stable throughout
+
+
 def test_csv_has_each_points_harmonics(three_dof_adaptive):
     _, res = three_dof_adaptive
     lines = format_csv(res).splitlines()

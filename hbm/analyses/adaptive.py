@@ -79,7 +79,8 @@ def frf_to_tolerance(case, tol: float, harmonics=None, **kwargs):
     start = carried_harmonics(res)
     dropped = [int(x) for x in res.basis.harmonics if x not in start]
     res, refined = refine_points(case, res, tol, (lo, hi), kwargs.get("transform") or "auto",
-                                 kwargs.get("stability_options"), start)
+                                 kwargs.get("stability_options"), start, kwargs.get("progress"))
+    res = _confirmed(case, res, base_harmonics=int(max(h)))
     worst = _worst(res)
     checked = math.isfinite(worst)      # False: no point's error could be estimated (too large)
     res.settings["adaptive"] = {"tol": tol, "tried": tried, "points": refined, "checked": checked,
@@ -88,6 +89,23 @@ def frf_to_tolerance(case, tol: float, harmonics=None, **kwargs):
                                 "seconds": round(time.perf_counter() - t0, 4)}
     _restate_errors(res)
     return dataclasses.replace(res, solve_seconds=res.settings["adaptive"]["seconds"])
+
+
+def _confirmed(case, res, base_harmonics: int):
+    """``res`` with the refined points Hill calls unstable checked by Floquet multipliers, as
+    the FRF checks its own (:func:`hbm.timedomain.floquet_check.confirm_unstable`; full models)."""
+    from hbm.analyses.problem_setup import choose_solver
+    from hbm.timedomain.floquet_check import confirm_unstable
+    if res.stable is None or res.point_harmonics is None or choose_solver(case) != "full":
+        return res
+    refined = res.point_harmonics > base_harmonics
+    st = {}
+    checked = confirm_unstable(case, res.basis, res.X, res.freq_hz, res.stable | ~refined, st)
+    turned = st.get("floquet_overrides_hz", [])
+    if turned:
+        res.settings["floquet_overrides_hz"] = sorted(res.settings.get("floquet_overrides_hz", []) + turned)
+    res.settings["floquet_checked"] = res.settings.get("floquet_checked", 0) + st.get("floquet_checked", 0)
+    return dataclasses.replace(res, stable=np.where(refined, checked, res.stable))
 
 
 def _restate_errors(res) -> None:

@@ -128,13 +128,15 @@ def _point_record(case, lv: _Level, X, w, stability_options, with_stability: boo
     return rec
 
 
-def refine_points(case, res, tol: float, window_hz, transform="auto", stability_options=None, start=None):
+def refine_points(case, res, tol: float, window_hz, transform="auto", stability_options=None, start=None,
+                  progress=None):
     """``res`` with every point whose estimated error exceeds ``tol`` solved again on richer
     harmonics until within it (module doc).  Returns ``(result, info)``; ``info`` lists the
     levels (highest harmonic, samples, points solved there), the points left above ``tol``, the
     failed solves and the time taken.  ``start``: the harmonics whose richer sets are tried
     (default: the result's; :func:`hbm.analyses.adaptive.carried_harmonics` leaves out those that
-    carry nothing)."""
+    carry nothing).  ``progress.refining(done, total, H)`` is called per point when ``progress``
+    has it (:class:`hbm.interface.progress.FRFProgress`)."""
     t0 = time.perf_counter()
     todo = [int(i) for i in np.flatnonzero(over_tolerance(res, tol))]
     info = {"levels": [], "left_above": 0, "failed": 0}
@@ -150,7 +152,10 @@ def refine_points(case, res, tol: float, window_hz, transform="auto", stability_
         xs = _scaled_path(lv, res, current)
         info["levels"].append({"H": int(max(h)), "samples": int(N), "points": 0})
         left = []
-        for i in todo:
+        tell = getattr(progress, "refining", None)
+        for done, i in enumerate(todo):
+            if tell is not None:
+                tell(done, len(todo), int(max(h)))
             X0, w0, b0 = current[i]
             x0 = np.r_[lv.problem.unknowns(embed(X0, b0, lv.basis)), w0]
             x = solve_on_plane(lv.problem, x0, path_direction(xs, i, segments), lv.scale, lv.r_scale)

@@ -32,7 +32,8 @@ def compile_notice() -> None:
 class FRFProgress:
     """``progress(n_points, freq_hz)`` callback of :func:`hbm.analyses.response.frf` as a tqdm bar.
 
-    ``freq_hz = None`` announces the stability pass.
+    ``freq_hz = None`` announces the stability pass; :meth:`refining` counts the points that
+    ``--tol`` solves again.
     """
 
     def __init__(self, fmin: float, fmax: float):
@@ -53,6 +54,15 @@ class FRFProgress:
             self.bar.update(share - self.done)
             self.done = share
         self.bar.set_postfix_str(f"{n} points, {freq_hz:.5g} Hz", refresh=True)
+
+    def refining(self, done: int, total: int, top: int) -> None:
+        """Points solved again on richer harmonics (``hbm frf --tol``): ``done`` of ``total`` at
+        harmonics up to ``top``."""
+        if done == 0:
+            self.bar.reset(total=max(total, 1))
+            self.bar.set_description(f"refining points (H = {top})")
+        self.bar.update(done - self.bar.n)
+        self.bar.set_postfix_str(f"{done} of {total}", refresh=True)
 
     def close(self) -> None:
         self.bar.close()
