@@ -19,7 +19,9 @@ estimated on :math:`\mathcal H_{k+1}`; the ladder stops at ``tol`` or at
 the path keeps the cheap ones.
 
 A refined point is post-processed with its own problem: outputs, error estimate, energy
-balance, element outputs, stuck contacts and (when computed) Hill's verdict.  The result's
+balance, element outputs, stuck contacts and (when computed) Hill's verdict; a point on a
+bound of the window is solved there (the plane of fixed frequency).  The predicted jumps stay
+those of the traced path (their amplitudes within its estimated errors).  The result's
 basis is the richest used, every point's coefficients embedded in it (zero on the harmonics
 it did not carry), and ``FRFResult.point_harmonics`` holds each point's highest harmonic.
 """
@@ -60,6 +62,16 @@ def path_direction(xs: np.ndarray, i: int, segments) -> np.ndarray:
         d = np.zeros(xs.shape[1])
         d[-1], n = 1.0, 1.0
     return d / n
+
+
+def _normal(xs, i, segments, f_hz, window_hz) -> np.ndarray:
+    """The plane's normal at point ``i``: the path's direction, or the frequency axis for a
+    point on a bound of the window (it stays there)."""
+    if min(abs(f_hz - window_hz[0]), abs(f_hz - window_hz[1])) <= 1e-12 * abs(window_hz[1]):
+        t = np.zeros(xs.shape[1])
+        t[-1] = 1.0
+        return t
+    return path_direction(xs, i, segments)
 
 
 def solve_on_plane(problem, x0: np.ndarray, t: np.ndarray, scale: np.ndarray, r_scale: float,
@@ -158,7 +170,8 @@ def refine_points(case, res, tol: float, window_hz, transform="auto", stability_
                 tell(done, len(todo), int(max(h)))
             X0, w0, b0 = current[i]
             x0 = np.r_[lv.problem.unknowns(embed(X0, b0, lv.basis)), w0]
-            x = solve_on_plane(lv.problem, x0, path_direction(xs, i, segments), lv.scale, lv.r_scale)
+            x = solve_on_plane(lv.problem, x0, _normal(xs, i, segments, res.freq_hz[i], window_hz),
+                               lv.scale, lv.r_scale)
             if x is None:           # kept as last solved, with its estimate: still above tol
                 info["failed"] += 1
                 stuck_above.append(i)
