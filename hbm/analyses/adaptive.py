@@ -66,16 +66,18 @@ def frf_to_tolerance(case, tol: float, harmonics=None, **kwargs):
         raise ValueError(f"tol must be a positive number, got {tol!r}")
     h, _, lo, hi, _ = resolve_settings(case, harmonics, kwargs.get("samples"), kwargs.get("fmin"),
                                        kwargs.get("fmax"), kwargs.get("transform"))
-    h, tried, t0 = list(h), [], time.perf_counter()
+    # the first trace takes the harmonics as given (None: the case's, with the case's samples),
+    # the next ones their richer lists
+    h, given, tried, t0 = list(h), harmonics, [], time.perf_counter()
     while True:
         t1 = time.perf_counter()
-        res = frf(case, harmonics=h, error_estimate=True, **kwargs)
+        res = frf(case, harmonics=given, error_estimate=True, **kwargs)
         share = float(np.mean(over_tolerance(res, tol))) if res.freq_hz.size else 0.0
         tried.append({"H": int(max(h)), "max_error": _worst(res), "share_above": round(share, 4),
                       "seconds": round(time.perf_counter() - t1, 4), "status": res.status})
         if share <= WHOLE_SHARE or max(h) >= H_MAX or not res.ok or not math.isfinite(tried[-1]["max_error"]):
             break
-        h = next_harmonics(carried_harmonics(res))
+        h = given = next_harmonics(carried_harmonics(res))
     start = carried_harmonics(res)
     dropped = [int(x) for x in res.basis.harmonics if x not in start]
     res, refined = refine_points(case, res, tol, (lo, hi), kwargs.get("transform") or "auto",
