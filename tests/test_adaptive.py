@@ -148,6 +148,12 @@ def test_plane_solve_crosses_a_fold_where_fixed_frequency_cannot():
     assert abs(x[-1] / (2 * np.pi) - res.freq_hz[k]) < 0.01           # near the fold
 
 
+def test_the_first_trace_keeps_the_case_s_own_settings():
+    case = hbm.load_case("rigs/inclined_contact.toml")            # harmonics 5, time_samples 64
+    st = frf_to_tolerance(case, 1.0, stability=False).settings
+    assert st["time_samples"] == 64 and st["time_samples_source"] == "case" and st["harmonics_source"] == "case"
+
+
 def test_path_direction_is_one_sided_at_segment_ends():
     xs = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [5.0, 5.0]])
     assert np.allclose(path_direction(xs, 0, [(0, 3), (3, 4)]), [1, 0])
