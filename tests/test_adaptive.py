@@ -125,7 +125,7 @@ def test_harmonics_that_carry_something_are_kept():
     assert res.freq_hz[[0, -1]] == pytest.approx(case.analysis.freq_hz, rel=1e-12)
 
 
-def test_plane_solve_crosses_a_fold_where_fixed_frequency_cannot():
+def test_plane_solve_at_a_fold():
     """On the plane normal to the path a point at a fold is well posed: a Duffing oscillator's
     fold point, moved to richer harmonics, lands on the richer path near the fold."""
     case = hbm.case_from_dict({
