@@ -17,7 +17,6 @@ Writes ``benchmarks/results/adaptive_harmonics.csv``.
 """
 from __future__ import annotations
 
-import csv
 import sys
 from pathlib import Path
 
@@ -32,7 +31,7 @@ import hbm  # noqa: E402
 from hbm.analyses.adaptive import frf_to_tolerance, next_harmonics  # noqa: E402
 from hbm.analyses.response import solve_at  # noqa: E402
 from test_truncation import three_dof  # noqa: E402
-from time_vs_error import cpu  # noqa: E402
+from time_vs_error import cpu, write_rows  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 CASES = {
@@ -115,12 +114,7 @@ def main():
                 print(f"  {r['case']:<22} {r['run']:<42} {str(r['tol']):<7} {r['points']:4d} pts "
                       f"{r['seconds']:7.3f} s  true {r['true_error']:.2e}  est {r['estimate']:.2e}  {r['ratio']}"
                       + (f"; {r['ratio_known']} (estimate within tol)" if r["ratio_known"] else ""))
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    with open(RESULTS / "adaptive_harmonics.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-
+    write_rows(RESULTS / "adaptive_harmonics.csv", rows)
 
 if __name__ == "__main__":
     main()

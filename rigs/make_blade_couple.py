@@ -30,8 +30,7 @@ import matplotlib.pyplot as plt                                        # noqa: E
 from hbm.interface.case import case_from_dict                                    # noqa: E402
 from hbm.timedomain.timesim import TimeSimOptions, transient                      # noqa: E402
 from rigs.studies.blade_couple_sweep import (ContactLaw, Analysis, load_rig, with_contacts,  # noqa: E402
-                                             frf_of, peak_row, optimum, plot, write_csv,
-                                             runaway_peak)
+                                             frf_of, peak_row, optimum, plot, write_csv)
 
 OUT = RIGS / "blade_couple"
 DOC = RIGS / "blade_couple.md"

@@ -129,7 +129,7 @@ def plot_regimes(reg, path):
     fig, axes = plt.subplots(3, 4, figsize=(15, 9))
     idx = {n: i for i, n in enumerate(reg[next(iter(reg))]["case"].model.dof_names)}
     for r, (label, res) in enumerate(reg.items()):
-        run, case = res["run"], res["case"]
+        run = res["run"]
         N = run.steps
         n = 3 * N
         h = run.history
@@ -210,6 +210,15 @@ def plot_energy(rows, path):
     plt.close(fig)
 
 
+def write_csv(path: Path, rows: list) -> None:
+    """``rows`` (dicts with the same keys) as the CSV file ``path`` (its folder made)."""
+    path.parent.mkdir(exist_ok=True)
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
 def main():
     fig_dir, out_dir = ROOT / "rigs" / "figures", ROOT / "rigs" / "out"
     fig_dir.mkdir(exist_ok=True)
@@ -225,10 +234,7 @@ def main():
         print("    damper harmonics 1..11 relative to the 1st: " + " ".join(f"{v / a[0]:.1e}" for v in a))
     plot_regimes(reg, fig_dir / "cross_beam_regimes.png")
     rows = energy_curves()
-    with open(out_dir / "cross_beam_energy.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_csv(out_dir / "cross_beam_energy.csv", rows)
     for force in FORCES:
         b = optimum(rows, force)
         print(f"f = {force:g} N: optimum N = {b['N']:.3f} N, e = {b['e']:.3f}, slip fraction {b['slip_fraction']:.3f}")
