@@ -134,3 +134,23 @@ def test_summary_quantities_in_microslip_and_gross_slip():
     z = harmonic_motion(256, [1e-6 * a_gross, 0.0])
     s = br.summary(loop_forces(br, z), z)
     assert s["slip_fraction"] == 0.0 and abs(s["dissipation"]) < 1e-12
+
+
+def test_table2_partial_contact_case():
+    """Seed 002's Table 2 re-analysis at N = 20 N (2 mm of contact, k_w = 33 N/um): the
+    out-of-phase resonance as benchmarks/beam_damper_beam_table2.py measured it (583.5 Hz,
+    0.489 um), well below the whole-length contact's 677 Hz."""
+    import sys
+    import tempfile
+    from pathlib import Path
+    import hbm
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "benchmarks"))
+    from beam_damper_beam_table2 import TABLE2, case_for, model_with_kw, peak_in
+    length, k_w = TABLE2[20.0][:2]
+    with tempfile.TemporaryDirectory() as tmp:
+        res = hbm.frf(case_for(20.0, length, model_with_kw(k_w, Path(tmp))), fmin=550, fmax=650,
+                      stability=False)
+    assert res.ok, res.message
+    f, a = peak_in(res.freq_hz, res.outputs["tip_A"].h1, 560, 650)
+    assert f == pytest.approx(583.5, abs=1.0) and a * 1e6 == pytest.approx(0.4885, rel=0.02)
