@@ -171,7 +171,7 @@ def build_reduced(**overrides):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-o", "--out", default=str(Path(__file__).resolve().parents[1] / "beam_damper_beam_model.npz"))
+    ap.add_argument("-o", "--out", default=str(Path(__file__).resolve().parent / "beam_damper_beam_model.npz"))
     args = ap.parse_args(argv)
     M, K, names, info = build_reduced()
     np.savez(args.out, M=M, K=K, dof_names=np.array(names))

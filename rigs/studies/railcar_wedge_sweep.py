@@ -69,7 +69,7 @@ def hbm_from_timesim(case, freq_hz, run, harmonics=25, samples=STEPS):
     """HBM solution by Newton from the time-domain period; (X, basis) or None."""
     h, N, *_ = response.resolve_settings(case, harmonics, samples)
     basis = FourierBasis(h, N)
-    prob = response.build_problem(case, basis, "auto")
+    prob = response.build_problem(case, basis, "auto")[0]
     # the recorded steady period starts at a whole number of periods: phase 0
     q = run.history.q[:-1]
     if q.shape[0] != N:
