@@ -22,8 +22,9 @@ A refined point is post-processed with its own problem: outputs, error estimate,
 balance, element outputs, stuck contacts and (when computed) Hill's verdict; a point on a
 bound of the window is solved there (the plane of fixed frequency).  The predicted jumps stay
 those of the traced path (their amplitudes within its estimated errors).  The result's
-basis is the richest used, every point's coefficients embedded in it (zero on the harmonics
-it did not carry), and ``FRFResult.point_harmonics`` holds each point's highest harmonic.
+basis holds every harmonic used, every point's coefficients embedded in it (zero on the
+harmonics it did not carry), and ``FRFResult.point_harmonics`` holds each point's highest
+harmonic.
 """
 from __future__ import annotations
 
@@ -200,7 +201,7 @@ def _scaled_path(lv: _Level, res, current) -> np.ndarray:
 
 
 def _merged(res, records: dict):
-    """``res`` on the richest basis of ``records``, their points replacing its own."""
+    """``res`` on a basis holding its harmonics and those of ``records``, their points replacing its own."""
     top = max((r["basis"] for r in records.values()), key=lambda b: b.n_coef)
     rb = FourierBasis(np.union1d(res.basis.harmonics, top.harmonics), top.n_samples)
     n = res.freq_hz.size

@@ -73,7 +73,8 @@ class FRFResult:
     point with one has a family of periodic solutions), None without such contacts."""
     point_harmonics: np.ndarray | None = None
     """Highest harmonic of every point (n_points,) when ``hbm frf --tol`` chose them point by
-    point (:mod:`hbm.analyses.point_harmonics`; ``X`` and ``Y`` are then on the richest basis),
+    point (:mod:`hbm.analyses.point_harmonics`; ``X`` and ``Y`` are then on a basis holding
+    every harmonic used),
     else None: every point on ``basis``."""
 
     @property
