@@ -202,8 +202,9 @@ def _scaled_path(lv: _Level, res, current) -> np.ndarray:
 
 def _merged(res, records: dict):
     """``res`` on a basis holding its harmonics and those of ``records``, their points replacing its own."""
-    top = max((r["basis"] for r in records.values()), key=lambda b: b.n_coef)
-    rb = FourierBasis(np.union1d(res.basis.harmonics, top.harmonics), top.n_samples)
+    bases = [r["basis"] for r in records.values()]
+    h = np.unique(np.concatenate([res.basis.harmonics] + [b.harmonics for b in bases]))
+    rb = FourierBasis(h, max(b.n_samples for b in bases))
     n = res.freq_hz.size
     X, Y = embed(res.X, res.basis, rb, axis=1), embed(res.Y, res.basis, rb, axis=1)
     freq = res.freq_hz.copy()
