@@ -152,7 +152,7 @@ def refine_points(case, res, tol: float, window_hz, transform="auto", stability_
     has it (:class:`hbm.interface.progress.FRFProgress`)."""
     t0 = time.perf_counter()
     todo = [int(i) for i in np.flatnonzero(over_tolerance(res, tol))]
-    info = {"levels": [], "left_above": 0, "failed": 0}
+    info = {"levels": [], "left_above": 0, "failed": 0, "failed_hz": []}
     segments = res.settings.get("segments") or [(0, res.freq_hz.size)]
     current = {i: (res.X[i], 2 * np.pi * res.freq_hz[i], res.basis) for i in todo}
     records, h, stuck_above = {}, list(start if start is not None else res.basis.harmonics), []
@@ -175,6 +175,7 @@ def refine_points(case, res, tol: float, window_hz, transform="auto", stability_
                                lv.scale, lv.r_scale)
             if x is None:           # kept as last solved, with its estimate: still above tol
                 info["failed"] += 1
+                info["failed_hz"].append([round(float(w0) / (2 * np.pi), 6), int(max(h))])
                 stuck_above.append(i)
                 continue
             X, w = lv.problem.expand(x[:-1]), float(x[-1])

@@ -150,6 +150,11 @@ def _print_adaptive(a: dict, explicit: bool) -> None:
           f"({pts['seconds']:.2f} s)" + ("" if a["met"] else
                                          f": tolerance NOT met (largest estimate {a['max_error']:.1e}, "
                                          f"{pts['left_above']} points above, {pts['failed']} refinements failed)"))
+    if pts.get("failed_hz"):
+        where = ", ".join(f"{f:.6g} Hz (H = {h})" for f, h in pts["failed_hz"][:5])
+        print(f"  note: the richer solve did not converge at {where}: those points keep their last "
+              f"solution and estimate (near a fold, or a stiff contact's switch: see contact_hint or the "
+              f"README's \"Stiff contacts\"; a larger --tol accepts them)", file=sys.stderr)
 
 
 def cmd_frf(args) -> int:
