@@ -164,3 +164,25 @@ def test_path_direction_is_one_sided_at_segment_ends():
 def test_bad_tolerance():
     with pytest.raises(ValueError, match="positive"):
         frf_to_tolerance(three_dof(), 0.0)
+
+
+def test_a_failed_refinement_is_named_and_counted(monkeypatch):
+    """A point whose richer solve fails keeps its solution and estimate, is counted above the
+    tolerance and named by frequency and harmonics; the run says the tolerance is not met."""
+    import hbm.analyses.point_harmonics as ph
+    solve = ph.solve_on_plane
+    first = []
+
+    def flaky(problem, x0, t, scale, r_scale, tol=1e-10):
+        if not first:
+            first.append(x0[-1] / (2 * np.pi))
+            return None
+        return solve(problem, x0, t, scale, r_scale, tol)
+
+    monkeypatch.setattr(ph, "solve_on_plane", flaky)
+    res = frf_to_tolerance(three_dof(), 1e-2, stability=False)
+    pts = res.settings["adaptive"]["points"]
+    assert pts["failed"] == 1 and pts["left_above"] == 1 and not res.settings["adaptive"]["met"]
+    assert pts["failed_hz"] == [[round(first[0], 6), 11]]
+    k = int(np.argmin(np.abs(res.freq_hz - first[0])))
+    assert res.point_harmonics[k] == 7 and res.outputs["x3"].err[k] > 1e-2
