@@ -7,7 +7,8 @@ stiffness ``k_d`` is refitted so that the first stuck frequency stays 45.7 Hz
 (:func:`make_cross_beam_model.fit_damper`); then the three regimes are rerun as in
 :mod:`rigs.studies.cross_beam_study` (from rest, 200 periods, f = 20 N at 240 rad/s, slip
 fraction of the last 20 periods) at N = 2.85, 17.1 and 22.8 N, with the rig's mu_s = 0.30 and
-mu_k = 0.25.
+mu_k = 0.25; and the damper's odd superharmonics in the stick-slip regime (17.1 N), which the
+paper sees vanish above 3x.
 
 Run: ``python rigs/studies/cross_beam_damper_mass.py`` (about 20 s); writes
 ``rigs/out/cross_beam_damper_mass.csv``.
@@ -47,28 +48,37 @@ def model_with(m_d: float, folder: Path) -> tuple[Path, float, np.ndarray]:
     return path, k_d, mk.first_frequencies(K + mk.stuck_stiffness(K.shape[0]), M, 2)
 
 
-def slip_fractions(model: Path) -> dict:
-    """Slip fraction (time domain) at each of the study's three normal loads, on ``model``."""
+def regimes(model: Path) -> tuple[dict, np.ndarray]:
+    """Slip fraction (time domain) at each of the study's three normal loads on ``model``, and
+    the damper's harmonics 3, 5, 7, 9 relative to its first in the stick-slip regime (17.1 N)."""
     raw = tomllib.loads(st.CASE.read_text())
     raw["model"] = dict(raw["model"], file=str(model))
-    out = {}
+    out, harm = {}, None
     for N in st.LOADS.values():
         r = dict(raw, element=[dict(e, normal_load=N) for e in raw["element"]])
         case = case_from_dict(r, str(st.CASE), st.CASE.parent)
-        out[N] = st.slip_fraction_time(case, st.from_rest(case), st.SHOW)
-    return out
+        run = st.from_rest(case)
+        out[N] = st.slip_fraction_time(case, run, st.SHOW)
+        if N == st.LOADS["stick-slip"]:
+            q = run.history.q[-st.SHOW * run.steps:, case.model.dof_index["dL.x"]]
+            a = st.harmonic_amplitudes(q, run.steps)
+            harm = a[[2, 4, 6, 8]] / a[0]
+    return out, harm
 
 
 def main():
     rows = []
-    print(" m_d (g)   k_d (N/m)  stuck f1 / f2 (Hz)    slip fraction at N = " + " / ".join(f"{n:g}" for n in st.LOADS.values()))
+    print(" m_d (g)   k_d (N/m)  stuck f1 / f2 (Hz)    slip fraction at N = " + " / ".join(f"{n:g}" for n in st.LOADS.values())
+          + "    damper 3x / 5x / 7x / 9x at 17.1 N (rel. to 1x)")
     with tempfile.TemporaryDirectory() as tmp:
         for g in MASSES_G:
             model, k_d, f = model_with(g * 1e-3, Path(tmp))
-            s = slip_fractions(model)
+            s, harm = regimes(model)
             rows.append({"m_d_g": g, "k_d": round(k_d, 1), "stuck_f1_hz": round(f[0], 3), "stuck_f2_hz": round(f[1], 3),
-                         **{f"slip_{n:g}N": round(v, 3) for n, v in s.items()}})
-            print(f"{g:8.1f} {k_d:11.1f}  {f[0]:8.3f} / {f[1]:8.3f}    " + " / ".join(f"{v:.3f}" for v in s.values()))
+                         **{f"slip_{n:g}N": round(v, 3) for n, v in s.items()},
+                         **{f"damper_{h}x_17.1N": float(f"{v:.3g}") for h, v in zip((3, 5, 7, 9), harm)}})
+            print(f"{g:8.1f} {k_d:11.1f}  {f[0]:8.3f} / {f[1]:8.3f}    " + " / ".join(f"{v:.3f}" for v in s.values())
+                  + "    " + " / ".join(f"{v:.3f}" for v in harm))
     st.write_csv(ROOT / "rigs" / "out" / "cross_beam_damper_mass.csv", rows)
 
 if __name__ == "__main__":
