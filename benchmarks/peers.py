@@ -39,7 +39,6 @@ Without it the script times ours alone.  Writes ``benchmarks/results/peers.csv``
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
 import subprocess
@@ -57,6 +56,9 @@ sys.path.insert(0, str(ROOT))
 
 import hbm  # noqa: E402
 from hbm.analyses.response import solve_at  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from time_vs_error import write_rows  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 K = [[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]]
@@ -287,16 +289,6 @@ def ratios(rows):
             per_pt_w = (p["wall_s"] / p["points"]) / (o["wall_s"] / o["points"])
             print(f"  pyHarm {p['settings']} / hbm {o['settings']}: per FRF {per_frf:5.1f}x "
                   f"({per_frf_w:.1f}x), per point {per_pt:5.1f}x ({per_pt_w:.1f}x)")
-
-
-def write_rows(out, rows):
-    """``rows`` (dicts with the same keys) as the CSV file ``out``."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with open(out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    print(f"wrote {out}")
 
 
 def main():
