@@ -112,17 +112,13 @@ def _confirmed(case, res, base_harmonics: int):
 
 def _restate_errors(res) -> None:
     """``settings["error_estimate"]["max"]`` and the truncation warning after refinement."""
-    from hbm.analyses.truncation import WARN_ERROR
+    from hbm.analyses.truncation import largest_errors, truncation_warning
     est = res.settings.get("error_estimate") or {}
-    if "max" not in est:
+    if "max" not in est or res.point_harmonics is None:
         return
-    for name, o in res.outputs.items():
-        k = int(np.nanargmax(o.err)) if np.isfinite(o.err).any() else 0
-        est["max"][name] = {"error": float(o.err[k]), "freq_hz": float(res.freq_hz[k])}
-    top = max(est["max"].items(), key=lambda kv: kv[1]["error"])
-    if top[1]["error"] <= WARN_ERROR:
+    est["max"] = largest_errors(res.outputs, res.freq_hz)
+    warning = truncation_warning(est["max"], f"points refined up to H = {int(res.point_harmonics.max())}")
+    if warning:
+        res.settings["truncation_warning"] = warning
+    else:
         res.settings.pop("truncation_warning", None)
-    elif res.point_harmonics is not None:
-        res.settings["truncation_warning"] = (
-            f"estimated error of {top[0]} up to {top[1]['error']:.1%} at {top[1]['freq_hz']:.6g} Hz from the "
-            f"harmonic truncation after refining points up to H = {int(res.point_harmonics.max())}")

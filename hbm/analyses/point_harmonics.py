@@ -35,12 +35,12 @@ import numpy as np
 
 from hbm.analyses.adaptive import H_MAX, next_harmonics
 from hbm.analyses.hill_system import point_is_stable
-from hbm.analyses.problem_setup import _residual_scale, _unknown_scale, build_problem
+from hbm.analyses.problem_setup import _residual_scale, _unknown_scale, build_problem, output_amplitudes
 from hbm.analyses.result import OutputSeries
 from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.truncation import MAX_UNKNOWNS, richer_basis, embed, truncation_errors
 from hbm.balance.element_outputs import element_output_series
-from hbm.balance.fourier import FourierBasis, default_samples, max_abs
+from hbm.balance.fourier import FourierBasis, default_samples
 from hbm.balance.newton import newton
 
 
@@ -219,9 +219,7 @@ def _merged(res, records: dict):
         X[k], Y[k] = embed(r["X"], r["basis"], rb), embed(r["Y"], r["basis"], rb)
         freq[k], energy[k], H[k] = r["w"] / (2 * np.pi), r["energy"], int(r["basis"].harmonics.max())
         for j, a in enumerate(amps.values()):
-            rc = r["basis"].row_of(1, "c")
-            y = r["Y"][:, j]
-            a[0][k], a[1][k], a[2][k] = np.hypot(y[rc], y[rc + 1]), max_abs(r["basis"], y[:, None])[0], r["err"][j]
+            (a[0][k], a[1][k]), a[2][k] = output_amplitudes(r["basis"], r["Y"][:, j]), r["err"][j]
         for name, v in r["elements"].items():
             eouts[name][k] = v
         if stable is not None:

@@ -35,7 +35,8 @@ from hbm.analyses.stability import StabilityOptions
 from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.verdicts import landing_solver, path_verdicts
 from hbm.analyses.trace import _step_limit, trace_window  # noqa: F401 (_step_limit: tests)
-from hbm.analyses.truncation import MAX_UNKNOWNS, WARN_ERROR, harmonics_note, richer_basis, truncation_errors
+from hbm.analyses.truncation import (MAX_UNKNOWNS, harmonics_note, largest_errors, richer_basis,
+                                     truncation_errors, truncation_warning)
 
 __all__ = ["frf", "FRFResult", "OutputSeries", "build_problem", "choose_solver", "output_amplitudes",
            "recover_outputs", "resolve_settings", "solve_at"]
@@ -241,22 +242,15 @@ def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings, t_solve) -> 
     rp, _ = build_problem(case, rb, "auto", fmax_hz)
     E = truncation_errors(problem, rp, Xs, ws)
     info.update(computed=True, seconds=round(time.perf_counter() - t0, 6))
-    out, worst = {}, {}
-    for i, (name, o) in enumerate(outputs.items()):
-        out[name] = OutputSeries(o.h1, o.max, E[:, i])
-        k = int(np.nanargmax(E[:, i])) if np.isfinite(E[:, i]).any() else 0
-        worst[name] = {"error": float(E[k, i]), "freq_hz": float(ws[k] / (2 * np.pi))}
-    info["max"] = worst
+    out = {name: OutputSeries(o.h1, o.max, E[:, i]) for i, (name, o) in enumerate(outputs.items())}
+    worst = info["max"] = largest_errors(out, ws / (2 * np.pi))
     settings["error_estimate"] = info
     H = int(problem.basis.harmonics.max())
     top = max((v["error"] for v in worst.values()), default=0.0)
     note = harmonics_note(H, top, problem.n_unknowns, time.perf_counter() - t_solve)
     if note:
         settings["harmonics_note"] = note
-    bad = {n: v for n, v in worst.items() if v["error"] > WARN_ERROR}
-    if bad:
-        n, v = max(bad.items(), key=lambda kv: kv[1]["error"])
-        settings["truncation_warning"] = (
-            f"estimated error of {n} up to {v['error']:.1%} at {v['freq_hz']:.6g} Hz from the harmonic "
-            f"truncation (H = {int(problem.basis.harmonics.max())}): raise harmonics")
+    warning = truncation_warning(worst, f"H = {H}", ": raise harmonics")
+    if warning:
+        settings["truncation_warning"] = warning
     return out

@@ -53,6 +53,27 @@ def harmonics_note(H: int, top: float, n_unknowns: int, seconds: float) -> str |
             f"systems grow as their square, their factorisations as their cube)")
 
 
+def largest_errors(outputs: dict, freq_hz: np.ndarray) -> dict:
+    """Per output (``OutputSeries`` with ``err``), its largest estimated error and where:
+    ``{name: {"error": e, "freq_hz": f}}``; ``freq_hz`` (n_points,)."""
+    out = {}
+    for name, o in outputs.items():
+        k = int(np.nanargmax(o.err)) if np.isfinite(o.err).any() else 0
+        out[name] = {"error": float(o.err[k]), "freq_hz": float(freq_hz[k])}
+    return out
+
+
+def truncation_warning(worst: dict, harmonics: str, advice: str = "") -> str | None:
+    """The warning for the largest of :func:`largest_errors`'s ``worst`` above
+    :data:`WARN_ERROR`, naming the ``harmonics`` it was computed with; None when none is."""
+    bad = {n: v for n, v in worst.items() if v["error"] > WARN_ERROR}
+    if not bad:
+        return None
+    n, v = max(bad.items(), key=lambda kv: kv[1]["error"])
+    return (f"estimated error of {n} up to {v['error']:.1%} at {v['freq_hz']:.6g} Hz from the harmonic "
+            f"truncation ({harmonics}){advice}")
+
+
 def richer_basis(basis: FourierBasis) -> FourierBasis:
     """The harmonics of ``basis`` continued to ``2 H + 1`` in the same pattern (odd only when
     ``basis`` has odd harmonics only), mean kept when present, on ``N' >= 4 N`` samples."""
