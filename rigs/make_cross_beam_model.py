@@ -177,12 +177,13 @@ def modal_damping(Kr, Mr, zeta=ZETA):
     return Mr @ Phi @ np.diag(2.0 * zeta * np.sqrt(w2)) @ Phi.T @ Mr
 
 
-def build():
-    """Everything the case and the tests need, as a dict."""
+def build(m_d=None):
+    """Everything the case and the tests need, as a dict; ``m_d`` (kg) the damper mass
+    (default ``M_D``), ``k_d`` fitted to it."""
     t_v, t_h = fit_thicknesses()
     K_fe, M_fe, G = cross_fe(t_v, t_h)
     Kr, Mr, _ = craig_bampton(K_fe, M_fe, G)
-    m_d, k_d = fit_damper(Kr, Mr)
+    m_d, k_d = fit_damper(Kr, Mr, m_d)
     K, M = assemble(Kr, Mr, m_d, k_d)
     C = np.zeros_like(K)
     nr = Kr.shape[0]

@@ -36,16 +36,10 @@ MASSES_G = (0.5, 1.0, 2.0, 5.0, 10.0)
 def model_with(m_d: float, folder: Path) -> tuple[Path, float, np.ndarray]:
     """The rig's model with damper mass ``m_d`` (kg) and ``k_d`` refitted, written in ``folder``;
     returns its path, ``k_d`` and the first two stuck frequencies (Hz)."""
-    t_v, t_h = mk.fit_thicknesses()
-    K_fe, M_fe, G = mk.cross_fe(t_v, t_h)
-    Kr, Mr, _ = mk.craig_bampton(K_fe, M_fe, G)
-    m_d, k_d = mk.fit_damper(Kr, Mr, m_d)
-    K, M = mk.assemble(Kr, Mr, m_d, k_d)
-    C = np.zeros_like(K)
-    C[:Kr.shape[0], :Kr.shape[0]] = mk.modal_damping(Kr, Mr)
+    b = mk.build(m_d)
     path = folder / f"cross_beam_{m_d * 1e3:g}g.npz"
-    np.savez(path, M=M, K=K, C=C, dof_names=np.array(mk.DOF_NAMES))
-    return path, k_d, mk.first_frequencies(K + mk.stuck_stiffness(K.shape[0]), M, 2)
+    np.savez(path, M=b["M"], K=b["K"], C=b["C"], dof_names=np.array(mk.DOF_NAMES))
+    return path, b["k_d"], b["stuck_hz"][:2]
 
 
 def regimes(model: Path) -> tuple[dict, np.ndarray]:
