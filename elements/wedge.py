@@ -9,7 +9,8 @@ displacement of point ``j`` (damper minus platform ``P_s``), for a small rotatio
 
 .. math::
 
-    \Delta = (d_x - r_y\, rz - q_{P_s,x},\; d_y + r_x\, rz - q_{P_s,y},\; d_z - q_{P_s,z}),
+    \Delta = (d_x - r_y\, rz - q_{P_s,x} + o_j t_{s,y} \theta_s,\;
+              d_y + r_x\, rz - q_{P_s,y} - o_j t_{s,x} \theta_s,\; d_z - q_{P_s,z}),
 
 and its local coordinates (the friction3d contact's ``t1, t2, n``) are
 
@@ -19,8 +20,13 @@ and its local coordinates (the friction3d contact's ``t1, t2, n``) are
     u_{t2} = d_z - q_z, \quad
     u_n = n_s \cdot \Delta_{xy} = \dots + (r \times n_s)\, rz
 
-(frames in :mod:`elements.wedge_statics`; ``u_n > 0`` closes).  These are rows of the gather
-matrix, so the contact forces act on platforms and damper through ``G^T f``.
+(frames in :mod:`elements.wedge_statics`; ``u_n > 0`` closes).  ``q_{P_s}`` are the platform's
+translations at the flank centre and ``theta_s`` its in-plane rotation (optional coordinate
+``rz`` of the side table, same sense as the damper's ``rz``: 0 when not given), so a rotation
+of the platform relative to the damper, ``rz - theta_s``, presses one end of the flank and
+lifts the other, ``u_n`` changing by ``o_j (t_s x n_s)(rz - theta_s)`` along it; a rigid
+rotation of damper and platforms together leaves every contact undeformed.  These are rows
+of the gather matrix, so the contact forces act on platforms and damper through ``G^T f``.
 
 Each point is a :class:`elements.friction3d.Friction3D` contact (the friction3d law, not a
 copy) with ``kt/p``, ``kn/p``, the flank's ``mu`` and the preload ``N_s/p``, where ``N_s``
@@ -39,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 
 from .base import Element
-from .keys import coordinate
+from .keys import coordinate, coordinate_row
 from .friction3d import Friction3D
 from .laws.registry import FRICTION3D
 from .wedge_params import KEYS, WedgeParams, parse_params, _sides
@@ -61,6 +67,15 @@ def _sub(g, row, scale):
         g[j] -= scale * c
 
 
+def _rotation(spec, n_dof, dof_index, where) -> dict:
+    """A platform rotation ``rz`` as ``{dof: coefficient}``: a DOF, or weighted DOFs such as
+    ``{ "blade1.n8.ry" = -1.0 }`` (an axis of the opposite sense); ``{}`` when not given."""
+    if spec is None:
+        return {}
+    row = coordinate_row(spec, n_dof, dof_index, where)
+    return {int(j): float(row[j]) for j in np.flatnonzero(row)}
+
+
 def _cross(r, v):
     """z component of the plane cross product ``r x v``."""
     return r[0] * v[1] - r[1] * v[0]
@@ -75,12 +90,15 @@ class WedgeDamper(Element):
     platform : sequence of 2 tuples
         Platform coordinates ``(x, y)`` or ``(x, y, z)`` of the left and right contacts, each
         a DOF index or a combination ``{dof: coefficient}`` (a point coordinate such as
-        ``"blade1.platform.x"`` of a beam assembly, ``u_p = u_n + theta_n x r``).
+        ``"blade1.platform.x"`` of a beam assembly, ``u_p = u_n + theta_n x r``), taken at the
+        flank centre.
     damper : sequence of int
         Model indices of the damper DOFs, in the order ``params.dof_suffixes``.
     n_dof : int
         Size of the (augmented) model.
     name : str
+    turns : sequence of 2 dicts, optional
+        In-plane rotation ``theta_s`` of each platform as ``{dof: coefficient}`` (none if empty).
     """
 
     kind = FRICTION3D
@@ -90,7 +108,7 @@ class WedgeDamper(Element):
     default_harmonics = 5           # benchmarks/default_harmonics.py
     default_samples_factor = 1
 
-    def __init__(self, params: WedgeParams, platform, damper, n_dof, name="wedge_damper"):
+    def __init__(self, params: WedgeParams, platform, damper, n_dof, name="wedge_damper", turns=None):
         self.wedge = params
         self.damper_index = np.array(damper, dtype=int)
         self.damper_index.setflags(write=False)
@@ -103,6 +121,7 @@ class WedgeDamper(Element):
         col = dict(zip(params.dof_suffixes, self.damper_index))
         contacts, flank = [], []
         rows_of = [[_as_row(c) for c in platform[s]] for s in range(2)]
+        turns = turns if turns is not None else ({}, {})
         for s in range(2):
             ps = rows_of[s]
             centre = params.centres[s] if params.rotates else np.zeros(2)
@@ -122,6 +141,7 @@ class WedgeDamper(Element):
                         g[col["y"]] += v[1]
                         if params.rotates:
                             g[col["rz"]] += _cross(r, v)
+                            _sub(g, turns[s], _cross(off * t[s], v))
                         _sub(g, ps[0], v[0])
                         _sub(g, ps[1], v[1])
                     rows.append(g)
@@ -160,10 +180,11 @@ class WedgeDamper(Element):
         """Build from a case table; the damper DOFs ``<name>.x`` ... must already be in the model."""
         params = parse_params(spec, where)
         name = spec.get("name", "wedge_damper")
-        platform = []
+        platform, turns = [], []
         for side, d in zip(SIDES, _sides(spec, where)):
             keys = ("x", "y", "z") if params.three_d else ("x", "y")
             platform.append(tuple(coordinate(d[k], n_dof, dof_index, f"{where}: {side}.{k}") for k in keys))
+            turns.append(_rotation(d.get("rz"), n_dof, dof_index, f"{where}: {side}.rz"))
         damper = []
         for s in params.dof_suffixes:
             dn = f"{name}.{s}"
@@ -171,10 +192,10 @@ class WedgeDamper(Element):
                 raise ValueError(f"{where}: damper DOF {dn!r} is not in the model (wedge_damper adds "
                                  f"its DOFs when the case is loaded by hbm.interface.case)")
             damper.append(int(dof_index[dn]))
-        used = {i for pl in platform for c in pl for i in c}
+        used = {i for pl in platform for c in pl for i in c} | {i for t in turns for i in t}
         if used & set(damper):
             raise ValueError(f"{where}: platform DOFs must not be damper DOFs")
-        return cls(params, platform, damper, n_dof, name)
+        return cls(params, platform, damper, n_dof, name, turns)
 
     # --- element interface -------------------------------------------------------------
     def _rows(self, k):

@@ -2,8 +2,8 @@ r"""Parameters of the wedge (cottage-roof) damper, read and checked from a case 
 
 Case keys (``[[element]] type = "wedge_damper"``)::
 
-    left  = { x = dof, y = dof, z = dof }   # platform DOFs at the left contact (z optional)
-    right = { x = dof, y = dof, z = dof }   # ... at the right contact (z on both or neither)
+    left  = { x = dof, y = dof, z = dof, rz = dof }   # platform DOFs at the left flank centre
+    right = { x = dof, y = dof, z = dof, rz = dof }   # ... right (z on both or neither; rz optional)
     angles_deg = [aL, aR]     # flank angles from the horizontal, degrees, in (0, 90)
     mass = m                  # damper mass, kg
     inertia = J               # in-plane rotational inertia about the CG, kg m^2 (points_per_flank >= 2)
@@ -16,8 +16,11 @@ Case keys (``[[element]] type = "wedge_damper"``)::
     flank_length = L          # m, needed when points_per_flank >= 2 (points at -L/2 .. L/2)
     centres = [[xL, yL], [xR, yR]]   # flank centres relative to the CG, m (points_per_flank >= 2)
 
-With ``points_per_flank = 1`` the keys ``inertia``, ``flank_length`` and ``centres`` are
-accepted and not used (no rotation DOF), so a case can switch between the two models.
+``rz`` is the platform's in-plane rotation (same sense as the damper's: turning x towards
+y), a DOF or weighted DOFs ``{ "blade1.n8.ry" = -1.0 }``; it presses or lifts the points of a
+flank (:mod:`elements.wedge`).  With ``points_per_flank = 1`` the keys ``inertia``,
+``flank_length``, ``centres`` and ``rz`` are accepted and not used (no rotation DOF, one
+point at the flank centre), so a case can switch between the two models.
 
 Axes: ``x`` across the gap (left to right), ``y`` along ``CF`` (towards the platforms), ``z``
 axial.  The anchor stiffness fixes the damper's mean position, which friction alone leaves
@@ -37,7 +40,7 @@ from .wedge_statics import static_normal_loads
 KEYS = ("type", "name", "left", "right", "angles_deg", "mass", "inertia", "cf", "mu", "kt", "kn",
         "wire_stiffness", "anchor_stiffness", "points_per_flank", "flank_length", "centres")
 REQUIRED = ("left", "right", "angles_deg", "mass", "cf", "mu", "kt", "kn")
-SIDE_KEYS = ("x", "y", "z")
+SIDE_KEYS = ("x", "y", "z", "rz")
 ANCHOR_DEFAULT = 1e-6     # anchor_stiffness = ANCHOR_DEFAULT * kn unless given
 
 

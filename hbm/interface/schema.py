@@ -92,8 +92,9 @@ ELEMENTS = {
               "gamma_n": "normal stiffness factor with e_star (default: the Hertz contact area)",
               "gamma_t": "tangential stiffness factor with e_star",
               "pivot_height": "height of the rotation centre above the contact, m (default 0)"},
-    "wedge_damper": {"left": "table `{x, y [, z]}`: the left platform's DOFs at the contact",
-                     "right": "table `{x, y [, z]}`: the right platform's DOFs",
+    "wedge_damper": {"left": "table `{x, y [, z] [, rz]}`: the left platform's DOFs at the flank "
+                             "centre (rz: its in-plane rotation)",
+                     "right": "table `{x, y [, z] [, rz]}`: the right platform's DOFs",
                      "angles_deg": "`[aL, aR]`: flank angles from the horizontal, degrees",
                      "mass": "damper mass, kg", "inertia": "damper inertia, kg m^2 (rotating damper)",
                      "cf": "centrifugal load on the damper, N", "mu": "friction coefficient, or `[muL, muR]`",
