@@ -27,3 +27,57 @@ def test_a_stall_is_restarted_past_and_stated():
     assert res.energy_error.max() < 1e-8
     assert len(res.settings["segments"]) == len(gaps) + 1
     assert sum(e - s for s, e in res.settings["segments"]) == res.freq_hz.size
+
+
+# ------------------------------------------------------------------ restarts on a traced branch
+def duffing_setup():
+    """The hardening Duffing of tests/test_duffing.py (three solutions between its folds), its
+    FRF, and the problem with its scales."""
+    import numpy as np
+    from hbm.analyses.problem_setup import _residual_scale, _unknown_scale, build_problem, resolve_settings
+    from hbm.balance.fourier import FourierBasis
+    from test_duffing import duffing_case
+    case = duffing_case([1])
+    res = hbm.frf(case, stability=False, error_estimate=False)
+    h, N, lo, hi, tr = resolve_settings(case, None, None, None, None, None)
+    problem, _ = build_problem(case, FourierBasis(h, N), tr)
+    w_lo, w_hi = 2 * np.pi * lo, 2 * np.pi * hi
+    return case, res, problem, _unknown_scale(problem, case, w_lo, w_hi), _residual_scale(problem, w_lo)
+
+
+def branch_path(res, lo, hi):
+    """A traced path of the FRF points ``lo:hi``."""
+    import numpy as np
+    from hbm.analyses.trace import _Path
+    p = _Path()
+    for k in range(lo, hi):
+        p.X.append(np.asarray(res.X[k]))
+        p.w.append(2 * np.pi * res.freq_hz[k])
+    return p
+
+
+def test_a_fresh_start_on_the_branch_already_traced_is_passed_over():
+    """Cause of a restart loop on the UPD rig (rigs/upd_rig_flanks.toml at CF/Fexc = 100): the
+    path stopped on a fold's middle branch, the linear start past the stop converged on the
+    lower branch traced before, and the path went round to the same stop again and again
+    until max_points.  A start on a traced branch is now passed over."""
+    import numpy as np
+    import pytest
+    from hbm.analyses.problem_setup import _first_point
+    case, res, problem, xscale, r_scale = duffing_setup()
+    f1, f2 = sorted(res.folds_hz)
+    k2 = int(np.argmin(np.abs(res.freq_hz - f2)))       # upper branch: the path up to its peak fold
+    k1 = int(np.argmin(np.abs(res.freq_hz - f1)))       # lower branch: after the second fold
+    upper, lower = branch_path(res, 0, k2 + 1), branch_path(res, k1, res.freq_hz.size)
+    w = 2 * np.pi * 0.5 * (f1 + f2)
+    X, _ = _first_point(problem, case, w, xscale, r_scale, arclength_ramp=False)
+    assert lower.passes(X, w) and not upper.passes(X, w)          # the linear start finds the lower branch
+    X2, _ = _first_point(problem, case, w, xscale, r_scale, arclength_ramp=False,
+                         avoid=lambda X: upper.passes(X, w))
+    assert np.abs(X2 - X).max() <= 1e-10 * np.abs(X).max()          # not avoided: the same point
+    with pytest.raises(RuntimeError, match="already traced"):
+        _first_point(problem, case, w, xscale, r_scale, arclength_ramp=False,
+                     avoid=lambda X: lower.passes(X, w))
+    # a point off every chord, and frequencies outside the traced span, are not on the path
+    assert not lower.passes(1.05 * X, w)
+    assert not lower.passes(X, 2 * np.pi * 10 * f2)

@@ -53,7 +53,7 @@ def test_restart_falls_back_on_the_time_domain(sdof, monkeypatch):
         raise RuntimeError("linear starts fail")
     monkeypatch.setattr(trace, "_first_point", no_newton)
     w_from = 2 * np.pi * 33.0
-    X, its, w = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale)
+    X, its, w = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale, trace._Path())
     assert w == pytest.approx(w_from + trace.GAP_FIRST * (window[1] - window[0]))
     R = problem.residual(X, w)[0]
     assert np.abs(R).max() < 1e-8 * np.abs(problem.residual(np.zeros_like(X), w)[0]).max()
@@ -61,5 +61,5 @@ def test_restart_falls_back_on_the_time_domain(sdof, monkeypatch):
     def no_period(*args, **kwargs):
         raise RuntimeError("a time integration from rest found no periodic response in 600 periods")
     monkeypatch.setattr(trace, "time_domain_start", no_period)
-    why = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale)
+    why = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale, trace._Path())
     assert why == "a time integration from rest found no periodic response in 600 periods"

@@ -177,7 +177,7 @@ def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
     return np.tile(s, problem.basis.n_coef)
 
 
-def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
+def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True, avoid=None):
     """Converged first point ``X`` (n_coef, n) at ``w0``, or raise RuntimeError with the reason.
 
     Newton from the linear response with the elements stuck, then without them; failing
@@ -187,17 +187,19 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
     traced by pseudo-arclength continuation through its folds (:func:`_homotopy_path`) unless
     ``arclength_ramp`` is False (a restart past a stop, which tries several frequencies: there
     the traced ramp cost half the run on the cross beam and found nothing the next try did not).
+    A solution for which ``avoid(X)`` is true (a branch already traced) is passed over.
     """
+    avoid = avoid if avoid is not None else (lambda X: False)
     fun = lambda x: problem.residual(problem.expand(x), w0)[:2]
     blocks = problem.solver_structure()
     guesses = [problem.linear_solution(w0, problem.stuck_stiffness()), problem.linear_solution(w0)]
-    last = None
+    linear = ""
     for g in guesses:
         res = newton(fun, problem.unknowns(g), scale=scale, r_scale=r_scale, overwrite_jacobian=True,
                      blocks=blocks)
-        if res.converged:
+        if res.converged and not avoid(problem.expand(res.x)):
             return problem.expand(res.x), res.iterations
-        last = res
+        linear = "converged on the branch already traced" if res.converged else res.message
     x = np.zeros(problem.n_unknowns)
     R0 = fun(x)[0]
     its = 0
@@ -209,15 +211,18 @@ def _first_point(problem, case, w0, scale, r_scale, arclength_ramp=True):
                      blocks=blocks)
         its += res.iterations
         if not res.converged:
+            ramp = f"ramp stopped at {lam:.0%} of the excitation: {res.message}"
             break
         x = res.x
     else:
-        return problem.expand(x), its
-    ramp = f"ramp stopped at {lam:.0%} of the excitation: {res.message}"
+        if not avoid(problem.expand(x)):
+            return problem.expand(x), its
+        ramp = "the ramp converged on the branch already traced"
     x, its_h, why = _homotopy_path(fun, R0, scale, r_scale, blocks) if arclength_ramp else (None, 0, "no arclength ramp")
-    if x is None:
+    if x is None or avoid(problem.expand(x)):
+        why = why if x is None else "the traced ramp reached the branch already traced"
         raise RuntimeError(f"first point at {w0 / (2 * np.pi):.6g} Hz did not converge "
-                           f"(linear starts: {last.message}; {ramp}; {why})")
+                           f"(linear starts: {linear}; {ramp}; {why})")
     return problem.expand(x), its + its_h
 
 

@@ -29,6 +29,7 @@ POLISH_ENERGY = 1e-10
 # balance's resolution there, CondensedLinear.work_resolution) is not a solution the FRF can
 # report: the path ends before it (status failed, the point named)
 ENERGY_LIMIT = 1e-8
+ON_PATH = 1e-2         # a restart within this (relative) of the traced path is not a new branch
 
 
 def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
@@ -109,6 +110,29 @@ class _Path:
         k = 1 if skip_first else 0
         for name in self.FIELDS:
             getattr(self, name).extend(getattr(other, name)[k:][::-1])
+
+    def passes(self, X: np.ndarray, w: float, rtol: float = ON_PATH) -> bool:
+        """Whether ``(X, w)`` lies on the traced path: within ``rtol`` (relative, 2-norm of the
+        coefficients) of the chord between two consecutive points whose frequencies bracket
+        ``w``.  A chord across two segments' ends is counted too, which can only call a new
+        point old (a restart then tries further on), never the reverse.
+
+        Parameters
+        ----------
+        X : ndarray, shape (n_coef, n)
+        w : float
+        """
+        w_all = np.asarray(self.w)
+        if w_all.size < 2:
+            return False
+        a, b = w_all[:-1], w_all[1:]
+        for i in np.flatnonzero((np.minimum(a, b) <= w) & (w <= np.maximum(a, b))):
+            span = b[i] - a[i]
+            s = 0.0 if span == 0 else (w - a[i]) / span
+            Xi = (1 - s) * self.X[i] + s * self.X[i + 1]
+            if np.linalg.norm(X - Xi) <= rtol * max(np.linalg.norm(Xi), np.linalg.norm(X)):
+                return True
+        return False
 
     def insert(self, at: int, segments, k: int, other: "_Path", lo: int, hi: int) -> int:
         """Insert ``other``'s points ``lo:hi`` before point ``at``, which lies in segment ``k`` of
@@ -203,11 +227,16 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
     """
     status, message, folds, n_rej = outcome
     w_lo, w_hi = window
-    gaps = []
+    gaps, restarts = [], 0
     while (status == "failed" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9) and len(gaps) < MAX_GAPS
            and len(pts.w) < case.analysis.max_points):
+        if restarts == MAX_GAPS:
+            message += (f"; {MAX_GAPS} restarts past stops were made and the path still stops, so "
+                        f"no more are tried")
+            break
+        restarts += 1
         w_from = pts.w[-1]
-        restart = _fresh_point_past(problem, case, w_from, window, xscale, r_scale)
+        restart = _fresh_point_past(problem, case, w_from, window, xscale, r_scale, pts)
         if isinstance(restart, str):
             w_end = min(w_from + GAP_FIRST * 2 ** (GAP_TRIES - 1) * (w_hi - w_lo), w_hi)
             message += (f"; no restart past it converged up to {w_end / (2 * np.pi):.6g} Hz ({restart}): "
@@ -234,16 +263,19 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
     return status, message, folds, n_rej
 
 
-def _fresh_point_past(problem, case, w_from, window, xscale, r_scale):
+def _fresh_point_past(problem, case, w_from, window, xscale, r_scale, traced):
     """``(X, iterations, w)`` solved a little past a stop at ``w_from``: Newton from the linear
     responses at ``GAP_FIRST`` of the window past it, doubled up to ``GAP_TRIES`` times; failing
     all, from a time integration's periodic response at the first and every ``TD_EVERY``-th
     of those frequencies, ``TD_TRIES`` at most (:mod:`hbm.analyses.td_start`, small full
-    models).  When nothing converges with a closed energy balance: why the time-domain start
-    failed (str)."""
+    models).  A solution on the path ``traced`` so far is not a restart: where the path
+    stopped on a fold's middle branch, the linear starts land on the branch already traced
+    (which the same fold would then send round again).  When nothing converges with a closed
+    energy balance: why the time-domain start failed (str)."""
     w_lo, w_hi = window
     ladder = sorted({min(w_from + GAP_FIRST * 2 ** k * (w_hi - w_lo), w_hi) for k in range(GAP_TRIES)})
-    starts = [(w_r, lambda w_r: _first_point(problem, case, w_r, xscale, r_scale, arclength_ramp=False))
+    starts = [(w_r, lambda w_r: _first_point(problem, case, w_r, xscale, r_scale, arclength_ramp=False,
+                                             avoid=lambda X, w_r=w_r: traced.passes(X, w_r)))
               for w_r in ladder]
     starts += [(w_r, lambda w_r: time_domain_start(problem, case, w_r, xscale, r_scale))
                for w_r in ladder[:TD_TRIES * TD_EVERY:TD_EVERY]]
@@ -254,6 +286,9 @@ def _fresh_point_past(problem, case, w_from, window, xscale, r_scale):
         except RuntimeError as exc:
             if k >= len(ladder):
                 why = str(exc)
+            continue
+        if traced.passes(Xr, w_r):
+            why = "the time-domain start settled on the branch already traced"
             continue
         eb = energy_balance(problem, Xr, w_r)
         err = eb.relative_error
