@@ -19,7 +19,7 @@ RIGS = {
     "blade_couple": (None, ["rigs/make_blade_couple.py"]),
     "beam_damper_beam": ("rigs/make_beam_damper_beam_model.py",
                          ["benchmarks/beam_damper_beam_study.py", "benchmarks/brush_loops.py"]),
-    "upd_rig": (None, ["rigs/make_upd_rig.py"]),      # no model file: the case builds its beams
+    "upd_rig": (None, ["rigs/make_upd_rig.py", "rigs/studies/upd_ip_softening.py"]),   # the case builds its beams
 }
 
 
