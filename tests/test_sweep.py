@@ -310,3 +310,18 @@ def test_workers_end_with_a_killed_sweep(tmp_path):
     for k in alive:
         os.kill(k, signal.SIGKILL)
     assert alive == []
+
+
+def test_overlay_is_not_drawn_across_an_untraced_stretch(tmp_path):
+    """A run that restarted past a stop has a gap in its path; the overlay of sweep.png must
+    break its line there (it drew a vertical line across the UPD rig's untraced fold before)."""
+    from hbm.interface.sweep_plot import _read_curve
+    (tmp_path / "frf.csv").write_text("freq_hz,x_h1\n1,1\n2,2\n3,3\n2.5,0.5\n4,1\n")
+    (tmp_path / "summary.json").write_text(json.dumps(
+        {"settings": {"gaps": [{"from_hz": 3.0, "to_hz": 3.2}], "segments": [[0, 3], [3, 5]]}}))
+    f, a = _read_curve(tmp_path / "frf.csv", "x")
+    assert f.size == 6 and np.isnan(f[3]) and np.isnan(a[3])
+    assert np.array_equal(a[[0, 1, 2, 4, 5]], [1, 2, 3, 0.5, 1])
+    # without gaps (segments of restarts that left nothing untraced) the curve is whole
+    (tmp_path / "summary.json").write_text(json.dumps({"settings": {"segments": [[0, 3], [3, 5]]}}))
+    assert np.isfinite(_read_curve(tmp_path / "frf.csv", "x")[0]).all()

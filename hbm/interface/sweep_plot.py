@@ -8,6 +8,7 @@ is logarithmic when asked (``--log``) or when the values span a factor of 100 or
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,9 @@ from hbm.analyses.sweep_summary import optimum
 
 
 def _read_curve(csv_path: Path, output: str):
-    """``(freq_hz, h1)`` of ``output`` from a run's ``frf.csv``, or None when unreadable."""
+    """``(freq_hz, h1)`` of ``output`` from a run's ``frf.csv``, or None when unreadable; a NaN
+    row is put where the run restarted past a stretch it did not trace (``settings.gaps`` and
+    ``segments`` of its ``summary.json``), so the line is not drawn across it."""
     try:
         with open(csv_path) as fh:
             head = fh.readline().strip().split(",")
@@ -24,7 +27,20 @@ def _read_curve(csv_path: Path, output: str):
         data = np.loadtxt(csv_path, delimiter=",", skiprows=1, usecols=(0, col), ndmin=2)
     except (OSError, ValueError):
         return None
+    cuts = _gap_starts(csv_path.parent / "summary.json", data.shape[0])
+    data = np.insert(data, cuts, np.nan, axis=0) if cuts else data
     return data[:, 0], data[:, 1]
+
+
+def _gap_starts(summary_path: Path, n: int) -> list:
+    """Indices of the points that start a new traced segment after an untraced gap."""
+    try:
+        settings = json.loads(summary_path.read_text()).get("settings", {})
+    except (OSError, ValueError):
+        return []
+    if not settings.get("gaps"):
+        return []
+    return [int(s) for s, _ in settings.get("segments", [])[1:] if 0 < int(s) < n]
 
 
 def _overlay(ax, rows, output, run_dirs, norm, cmap, unit):
