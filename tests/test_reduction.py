@@ -217,3 +217,23 @@ def test_bad_input_messages():
     Ksing = np.array([[1.0, -1.0], [-1.0, 1.0]])
     with pytest.raises(ValueError, match="singular"):
         reduce_model(np.eye(2), Ksing)
+
+
+@pytest.mark.parametrize("sparse", [False, True])
+def test_residual_flexibility_of_stiffnesses_on_very_different_scales(sparse):
+    """A DOF held only by a weak spring beside stiff ones (a damper on its anchor beside a
+    beam) made the static solve look singular (scipy warned, rcond 1e-16); the flexibility is
+    solved on the diagonally scaled stiffness: exact, and no warning."""
+    import warnings
+    Mc, Kc = chain(30, seed=7)
+    M, K = np.zeros((31, 31)), np.zeros((31, 31))
+    M[:30, :30], K[:30, :30] = Mc, 1e10 * Kc
+    M[30, 30], K[30, 30] = 1e-6, 1e-4    # a DOF of its own on a weak spring (a damper's anchor)
+    keep = [4, 29, 30]
+    KK = sp.csr_matrix(K) if sparse else K
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        red = reduce_model(sp.csr_matrix(M) if sparse else M, KK, n_modes=4, modal_damping=0.01,
+                           keep_dofs=keep)
+    exact = np.linalg.inv(K)[np.ix_(keep, keep)]
+    assert np.allclose(red.receptance(0.0).real, exact, rtol=1e-9, atol=1e-12 * np.abs(exact).max())
