@@ -22,9 +22,9 @@ run: $(STAMP)
 	$(BIN)/hbm frf $(CASE) -o out
 
 # one BLAS thread: the tests' matrices are small, and a threaded BLAS on busy cores slows
-# them by an order of magnitude
+# them by an order of magnitude; two worker processes (pytest-xdist), one per core
 test: $(STAMP)
-	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest tests
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest tests -n 2
 
 # the full stress matrix (minutes; STRESS_JOBS=n worker processes, default: all cores)
 stress: $(STAMP)
