@@ -287,7 +287,7 @@ def _fresh_point_past(problem, case, w_from, window, xscale, r_scale, traced):
             if k >= len(ladder):
                 why = str(exc)
             continue
-        if traced.passes(Xr, w_r):
+        if k >= len(ladder) and traced.passes(Xr, w_r):       # (the linear starts avoid it)
             why = "the time-domain start settled on the branch already traced"
             continue
         eb = energy_balance(problem, Xr, w_r)

@@ -21,6 +21,14 @@ import numpy as np
 JUMP_COLOURS = {"up": "tab:red", "down": "tab:blue"}
 
 
+def gap_starts(settings: dict) -> list:
+    """Path indices where a segment restarted past an untraced stretch begins (the drawn
+    curve breaks there): the segment starts of ``settings`` when it records ``gaps``."""
+    if not settings.get("gaps"):
+        return []
+    return [int(seg[0]) for seg in settings.get("segments", [])[1:]]
+
+
 def _runs(stable: np.ndarray, starts=()) -> list:
     """Index ranges ``(a, b, is_stable)`` of equal stability, each sharing its first point
     with the previous range so that the drawn curve has no gaps, except at ``starts``: path
@@ -102,8 +110,7 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
                              squeeze=False, gridspec_kw={"height_ratios": [ratios[p] for p in panels]})
     ax = axes[0, 0]
     stable = np.ones(res.freq_hz.size, dtype=bool) if res.stable is None else np.asarray(res.stable)
-    gap_starts = [seg[0] for seg in res.settings.get("segments", [])[1:]] if res.settings.get("gaps") else []
-    runs = _runs(stable, gap_starts)
+    runs = _runs(stable, gap_starts(res.settings))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, (name, o) in enumerate(res.outputs.items()):
         _draw_output(ax, res.freq_hz, o.h1 / scale, o.max / scale, runs, colours[k % len(colours)], name,

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from hbm.analyses.sweep_summary import optimum
+from hbm.interface.frf_plot import gap_starts
 
 
 def _read_curve(csv_path: Path, output: str):
@@ -27,20 +28,13 @@ def _read_curve(csv_path: Path, output: str):
         data = np.loadtxt(csv_path, delimiter=",", skiprows=1, usecols=(0, col), ndmin=2)
     except (OSError, ValueError):
         return None
-    cuts = _gap_starts(csv_path.parent / "summary.json", data.shape[0])
+    try:
+        settings = json.loads((csv_path.parent / "summary.json").read_text()).get("settings", {})
+    except (OSError, ValueError):
+        settings = {}
+    cuts = [i for i in gap_starts(settings) if 0 < i < data.shape[0]]
     data = np.insert(data, cuts, np.nan, axis=0) if cuts else data
     return data[:, 0], data[:, 1]
-
-
-def _gap_starts(summary_path: Path, n: int) -> list:
-    """Indices of the points that start a new traced segment after an untraced gap."""
-    try:
-        settings = json.loads(summary_path.read_text()).get("settings", {})
-    except (OSError, ValueError):
-        return []
-    if not settings.get("gaps"):
-        return []
-    return [int(s) for s, _ in settings.get("segments", [])[1:] if 0 < int(s) < n]
 
 
 def _overlay(ax, rows, output, run_dirs, norm, cmap, unit):
