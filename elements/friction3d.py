@@ -2,13 +2,20 @@
 separation (law in laws/friction3d.py)."""
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .base import Element
+from .friction2d_events import contact_harmonics
+from .jenkins_events import gauss_table
 from .keys import coordinate_rows, require_keys, finite, positive, non_negative
 from .law_march import START_PRINCIPAL, CLOSE_NEWTON
 from .laws.friction3d import n_states
 from .laws.registry import FRICTION3D
+
+
+_gauss = functools.lru_cache(maxsize=8)(gauss_table)
 
 
 class Friction3D(Element):
@@ -16,7 +23,8 @@ class Friction3D(Element):
 
     Case keys: ``type``, ``dofs = {t1 = ..., t2 = ..., n = ...}`` (``t2`` optional), ``kt``,
     ``kn`` (> 0), ``mu`` (>= 0), ``normal_preload`` (``N0 >= 0``), optional ``normal_gap``
-    (``g``, default 0) and ``name``.
+    (``g``, default 0), ``aft`` (``"sampled"``, default, or on a (t1, n) contact ``"events"``:
+    forces from the located events, :mod:`elements.friction2d_events`) and ``name``.
 
     Each local coordinate is a linear combination of model DOFs, one row of the gather
     matrix (:func:`elements.keys.coordinate_row`):
@@ -64,7 +72,7 @@ class Friction3D(Element):
     kind = FRICTION3D
     velocity = False
     needs_mean = True       # normal-load variation gives mean forces
-    keys = ("type", "dofs", "kt", "kn", "mu", "normal_preload", "normal_gap", "name")
+    keys = ("type", "dofs", "kt", "kn", "mu", "normal_preload", "normal_gap", "aft", "name")
     dof_keys = ("t1", "t2", "n")
     quantities = ("normal_load_min", "normal_load_max", "open_fraction", "slip_fraction",
                   "dissipation")
@@ -75,12 +83,16 @@ class Friction3D(Element):
     default_harmonics = 3           # benchmarks/default_harmonics.py
     default_samples_factor = 2
 
-    def __init__(self, gather, kt, kn, mu, normal_preload, name="friction3d", normal_gap=0.0):
+    def __init__(self, gather, kt, kn, mu, normal_preload, name="friction3d", normal_gap=0.0, aft="sampled"):
         G = np.array(gather, dtype=float, ndmin=2)
         if G.shape[0] not in (2, 3):
             raise ValueError(f"{name}: friction3d needs 2 (t1, n) or 3 (t1, t2, n) coordinates, "
                              f"got {G.shape[0]}")
         nt = G.shape[0] - 1
+        if aft not in ("sampled", "events") or (aft == "events" and nt == 2):
+            raise ValueError(f"{name}: aft must be \"sampled\" or, on a (t1, n) contact, \"events\"; "
+                             f"got {aft!r}" + (" with t2" if nt == 2 else ""))
+        self.aft = aft
         self.gap = finite("normal_gap", normal_gap)
         kn = positive("kn", kn)
         n_gap = non_negative("normal_preload", normal_preload) - kn * self.gap
@@ -101,7 +113,7 @@ class Friction3D(Element):
         G = coordinate_rows([dofs[k] for k in names], n_dof, dof_index,
                             [f"{where}: dofs.{k}" for k in names])
         return cls(G, spec["kt"], spec["kn"], spec["mu"], spec["normal_preload"],
-                   spec.get("name", "friction3d"), spec.get("normal_gap", 0.0))
+                   spec.get("name", "friction3d"), spec.get("normal_gap", 0.0), spec.get("aft", "sampled"))
 
     @property
     def n_tangential(self) -> int:
@@ -135,6 +147,31 @@ class Friction3D(Element):
         kt = self.kt if self.mu * self.normal_preload > 0.0 else 0.0
         kn = self.kn if self.params[3] >= 0.0 else 0.0
         return np.diag([kt] * nt + [kn])
+
+    def harmonic_forces(self, U, h, is_sin):
+        """Exact harmonic forces of a (t1, n) contact from its events (``aft = "events"``,
+        :mod:`elements.friction2d_events`).
+
+        Parameters
+        ----------
+        U : ndarray, shape (nc, 2)
+            Coefficients of ``u_t1``, ``u_n``.
+        h, is_sin : ndarray, shape (nc,)
+            The layout (:func:`elements.jenkins_events.row_kinds`).
+
+        Returns
+        -------
+        (F, dF) with shapes (nc, 2) and (nc, 2, 2 nc), or None when the law is to be marched
+        (a loop stuck with the slider at rest, where the march is exact).
+        """
+        nc = h.size
+        F, J = np.empty((nc, 2)), np.empty((nc, 2, nc, 2))
+        h_max = int(h.max())
+        gx, gw = _gauss(h_max)
+        if not contact_harmonics(h, is_sin, np.ascontiguousarray(U, dtype=float), self.params[:4].copy(),
+                                 16 * max(h_max, 4), gx, gw, F, J):
+            return None
+        return F, J.reshape(nc, 2, 2 * nc)
 
     def static_state(self) -> dict:
         return {"normal_preload": self.normal_preload, "normal_gap": self.gap}

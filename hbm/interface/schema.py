@@ -75,7 +75,10 @@ ELEMENTS = {
                    "mu": "friction coefficient", "normal_preload": "static normal load N0 >= 0, N "
                    "(the contact opens when N0 + kn (u_n - g) falls to 0)",
                    "normal_gap": "optional initial normal gap g, m (default 0): > 0 open at rest, "
-                   "< 0 an interference (static load N0 - kn g)"},
+                   "< 0 an interference (static load N0 - kn g)",
+                   "aft": "`\"sampled\"` (default) or, on a (t1, n) contact, `\"events\"` (forces "
+                          "integrated exactly between slip, stick, opening and re-contact events: no "
+                          "sampling error, for stiff and rigid contacts)"},
     "coulomb_stick_slip": {"kt": "stick stiffness, N/m", "normal_load": "normal load, N",
                            "mu_static": "static friction coefficient",
                            "mu_kinetic": "kinetic friction coefficient"},
