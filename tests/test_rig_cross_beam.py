@@ -66,6 +66,23 @@ def test_damper_spectra_odd_superharmonics(regimes):
     assert np.all(s[1:] < 1e-3)
 
 
+def test_pure_stick_keeps_the_free_vibration_at_the_stuck_frequencies(regimes):
+    """From rest with C = 0 the start-up transient of the stuck system never decays: the
+    spectrum of the last 100 periods has lines at its natural frequencies, 45.7 Hz (the
+    paper's quasi-periodic response; 6.0 % of the damper's 38.2 Hz line) and 234.2 Hz, beside
+    the forced harmonics; in stick-slip they are gone (below 0.2 %)."""
+    def line(N, f_hz):
+        case, run = regimes[N]
+        x = run.history.q[:, case.model.dof_index["dL.x"]]
+        f, a = st.line_near(x, run.steps, f_hz)
+        return f, a / st.harmonic_amplitudes(x[-st.SHOW * run.steps:], run.steps)[0]
+    f1, a1 = line(22.8, 45.7)
+    f2, a2 = line(22.8, 234.2)
+    assert f1 == pytest.approx(45.7, abs=0.05) and a1 > 0.01
+    assert f2 == pytest.approx(234.2, abs=0.1) and a2 > 1e-3
+    assert line(17.1, 45.7)[1] < 2e-3
+
+
 def test_three_regimes_by_hbm(regimes):
     # the steady periodic solutions at the gross-slip and stick loads (the stick-slip point
     # takes ~15 s and is in rigs/studies/cross_beam_study.py)

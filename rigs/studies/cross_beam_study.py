@@ -104,6 +104,29 @@ def harmonic_amplitudes(x, steps, n_h=11):
     return np.abs(X[p * np.arange(1, n_h + 1)])
 
 
+def spectrum(x, steps, periods=100, pad=8):
+    """Amplitude spectrum of the last ``periods`` periods of ``x`` (``steps`` samples each):
+    mean removed, Hann window, zero-padded ``pad`` times; ``(f / f_exc, amplitude)`` of shapes
+    (n_bins,), a sine of amplitude ``A`` peaking at about ``A``.  Unlike
+    :func:`harmonic_amplitudes` it shows lines between the harmonics, such as the free
+    vibration at the stuck frequencies that never decays in pure stick (C = 0)."""
+    n = periods * steps
+    seg = x[-n:] - np.mean(x[-n:])
+    w = np.hanning(n)
+    X = np.abs(np.fft.rfft(seg * w, pad * n)) * 2 / w.sum()
+    return np.arange(X.size) / (pad * periods), X
+
+
+def line_near(x, steps, f_hz, width_hz=5.0):
+    """``(frequency in Hz, amplitude)`` of the largest spectral line within ``width_hz`` of
+    ``f_hz`` (:func:`spectrum`)."""
+    r, X = spectrum(x, steps)
+    f = r * FREQ_HZ
+    m = np.abs(f - f_hz) < width_hz
+    k = np.flatnonzero(m)[np.argmax(X[m])]
+    return float(f[k]), float(X[k])
+
+
 def regimes():
     out = {}
     for label, N in LOADS.items():
@@ -148,15 +171,20 @@ def plot_regimes(reg, path):
         for c, (name, dof) in enumerate((("damper", "dL.x"), ("blade tip", "tip.x"))):
             ax = axes[r, 2 + c]
             a_t = harmonic_amplitudes(h.q[-SHOW * N:, idx[dof]], N)
+            r_s, a_s = spectrum(h.q[:, idx[dof]], N)
+            keep = (r_s > 0.5) & (r_s < 11.5)
+            ax.semilogy(r_s[keep], a_s[keep], "-", color="0.6", lw=0.6, label="time, spectrum (last 100 periods)")
             ax.semilogy(k, a_t, "o-", ms=4, label="time (last 20 periods)")
+            for f_st in (45.7, 234.2):
+                ax.axvline(f_st / FREQ_HZ, color="C3", ls=":", lw=0.8)
             if "X" in res:
                 Xd = res["X"][:, idx[dof]]
                 b = res["basis"]
                 a_h = [np.hypot(Xd[b.row_of(j)], Xd[b.row_of(j) + 1]) if j in b.harmonics else np.nan for j in k]
                 ax.semilogy(k, a_h, "s", ms=6, mfc="none", label="HBM")
-            ax.set_xlabel("harmonic of 38.2 Hz")
+            ax.set_xlabel("harmonic of 38.2 Hz (dotted: stuck 45.7, 234.2 Hz)")
             ax.set_ylabel(f"{name} amplitude (m)")
-            ax.set_ylim(bottom=max(1e-12, np.nanmax(a_t) * 1e-6))
+            ax.set_ylim(bottom=max(1e-12, np.nanmax(a_t) * 1e-6), top=np.nanmax(a_t) * 3)
             ax.legend(fontsize=7)
         ttl = f"slip fraction: time {res['slip_time']:.3f}, HBM {res['slip_hbm']:.3f}"
         axes[r, 0].set_title(ttl, fontsize=8)
@@ -232,6 +260,13 @@ def main():
         idx = res["case"].model.dof_index["dL.x"]
         a = harmonic_amplitudes(res["run"].history.q[-SHOW * res["run"].steps:, idx], res["run"].steps)
         print("    damper harmonics 1..11 relative to the 1st: " + " ".join(f"{v / a[0]:.1e}" for v in a))
+        q = res["run"].history.q
+        for dof in ("dL.x", "tip.x"):
+            lines = [line_near(q[:, res["case"].model.dof_index[dof]], res["run"].steps, f) for f in (45.7, 234.2)]
+            print(f"    {dof} lines between the harmonics (last 100 periods): "
+                  + ", ".join(f"{f:.2f} Hz {a / a_1:.1e} of the 1st" for (f, a), a_1 in
+                              zip(lines, [harmonic_amplitudes(q[-SHOW * res['run'].steps:,
+                                          res['case'].model.dof_index[dof]], res['run'].steps)[0]] * 2)))
     plot_regimes(reg, fig_dir / "cross_beam_regimes.png")
     rows = energy_curves()
     write_csv(out_dir / "cross_beam_energy.csv", rows)
