@@ -122,7 +122,7 @@ def test_a_chord_between_two_branches_is_not_filled():
     chord on one branch is filled."""
     from hbm.analyses.curve_bends import retrace_chord
     from hbm.analyses.problem_setup import _residual_scale, _unknown_scale, build_problem, resolve_settings
-    from hbm.analyses.trace import _Path
+    from hbm.analyses.traced_points import TracedPoints
     from hbm.balance.fourier import FourierBasis
     case = nlvib02()
     res = hbm.frf(case, stability=False, error_estimate=False)
@@ -135,7 +135,7 @@ def test_a_chord_between_two_branches_is_not_filled():
     r_scale = _residual_scale(problem, 2 * np.pi * lo)
 
     def chord(i, j):
-        pts = _Path()
+        pts = TracedPoints()
         for k in (i, j):
             pts.X.append(res.X[k]), pts.w.append(w[k]), pts.Y.append(res.Y[k])
             pts.its.append(1), pts.err.append(0.0), pts.unclosed.append(0)

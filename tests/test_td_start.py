@@ -11,6 +11,7 @@ import hbm
 import hbm.analyses.trace as trace
 from hbm.analyses.problem_setup import _residual_scale, _unknown_scale, build_problem, resolve_settings
 from hbm.analyses.td_start import fit_harmonics, time_domain_start
+from hbm.analyses.traced_points import TracedPoints
 from hbm.balance.fourier import FourierBasis
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -53,7 +54,7 @@ def test_restart_falls_back_on_the_time_domain(sdof, monkeypatch):
         raise RuntimeError("linear starts fail")
     monkeypatch.setattr(trace, "_first_point", no_newton)
     w_from = 2 * np.pi * 33.0
-    X, its, w = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale, trace._Path())
+    X, its, w = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale, TracedPoints())
     assert w == pytest.approx(w_from + trace.GAP_FIRST * (window[1] - window[0]))
     R = problem.residual(X, w)[0]
     assert np.abs(R).max() < 1e-8 * np.abs(problem.residual(np.zeros_like(X), w)[0]).max()
@@ -61,5 +62,5 @@ def test_restart_falls_back_on_the_time_domain(sdof, monkeypatch):
     def no_period(*args, **kwargs):
         raise RuntimeError("a time integration from rest found no periodic response in 600 periods")
     monkeypatch.setattr(trace, "time_domain_start", no_period)
-    why = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale, trace._Path())
+    why = trace._fresh_point_past(problem, case, w_from, window, xscale, r_scale, TracedPoints())
     assert why == "a time integration from rest found no periodic response in 600 periods"

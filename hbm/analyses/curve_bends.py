@@ -33,7 +33,8 @@ import numpy as np
 
 from continuation import ArclengthOptions
 
-from hbm.analyses.trace import _Path, _trace
+from hbm.analyses.trace import _trace
+from hbm.analyses.traced_points import TracedPoints
 
 CURVE_TOL = 5e-3        # largest distance of a chord from the path, in (ln f, ln a): 0.5 %
 FLAG_SHARE = 0.25       # a chord is re-traced when its estimated sag exceeds this share of it
@@ -85,7 +86,7 @@ def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xs
     ----------
     problem, case
         The FRF's problem and case.
-    pts : hbm.analyses.trace._Path
+    pts : hbm.analyses.traced_points.TracedPoints
         Traced points, changed in place.
     segments : list of [int, int]
         ``[start, end)`` of each segment, shifted by the insertion.
@@ -102,7 +103,7 @@ def retrace_chord(problem, case, pts, segments, k: int, i: int, n_steps: int, xs
     d = (u1 - problem.unknowns(pts.X[i])) / xscale
     ds = math.sqrt(float(d @ d) + 1.0) / n_steps
     opts = ArclengthOptions(ds0=ds, ds_max=ds, max_steps=4 * n_steps)
-    sub = _Path()
+    sub = TracedPoints()
     _trace(problem, case, sub, pts.X[i], 0, w0, (min(w0, w1), max(w0, w1)), 1 if w1 > w0 else -1,
            xscale, r_scale, opts, progress, offset=len(pts.w) - 1)
     if len(sub.w) < 3 or abs(sub.w[-1] - w1) > 1e-12 * abs(w1) \

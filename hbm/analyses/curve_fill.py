@@ -22,7 +22,7 @@ import numpy as np
 from hbm.balance.energy import energy_balance
 from hbm.balance.newton import newton
 from hbm.analyses.curve_bends import retrace_chord
-from hbm.analyses.trace import _Path
+from hbm.analyses.traced_points import TracedPoints
 
 MAX_SHARE = 1.0 / 60.0
 BRANCH_SHARE = 0.5      # a solved point farther than this share of the step from its guess is refused
@@ -43,8 +43,8 @@ def solve_near(problem, guess, w, radius, xscale, r_scale, tol=1e-10):
 def insert_point(problem, pts, segments, k, at, X, w, its, Y) -> None:
     """Insert the solved point ``(X, w)`` with outputs ``Y`` at path index ``at`` of segment
     ``k`` (its energy error and loop closure taken here); later segments shift by one."""
-    one = _Path()
-    for name, v in zip(_Path.FIELDS, (X, w, Y, its, energy_balance(problem, X, w).relative_error,
+    one = TracedPoints()
+    for name, v in zip(TracedPoints.FIELDS, (X, w, Y, its, energy_balance(problem, X, w).relative_error,
                                       problem.nl.last_unclosed)):
         getattr(one, name).append(v)
     pts.insert(at, segments, k, one, 0, 1)
@@ -58,7 +58,7 @@ def fill_long_steps(problem, case, pts, segments, outputs_of, window, xscale, r_
     ----------
     problem, case
         The FRF's problem and case.
-    pts : hbm.analyses.trace._Path
+    pts : hbm.analyses.traced_points.TracedPoints
         Traced points, changed in place.
     segments : list of [int, int]
         ``[start, end)`` of each traced segment, shifted by every insertion.

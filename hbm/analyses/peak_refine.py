@@ -71,7 +71,7 @@ def refine_peaks(problem, pts, segments, outputs_of, amplitudes, xscale, r_scale
     ----------
     problem
         The FRF's problem.
-    pts : hbm.analyses.trace._Path
+    pts : hbm.analyses.traced_points.TracedPoints
         The traced points (lists ``X, w, Y, its, err, unclosed``), changed in place.
     segments : list of [int, int]
         Index ranges ``[start, end)`` of the traced segments, shifted by every insertion.

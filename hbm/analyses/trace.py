@@ -23,13 +23,13 @@ from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
 from hbm.balance.energy import energy_balance
 from hbm.balance.newton import newton
 from hbm.analyses.td_start import time_domain_start
+from hbm.analyses.traced_points import TracedPoints
 
 POLISH_ENERGY = 1e-10
 # a point whose energy balance stays looser than this after polishing (and than twice the
 # balance's resolution there, CondensedLinear.work_resolution) is not a solution the FRF can
 # report: the path ends before it (status failed, the point named)
 ENERGY_LIMIT = 1e-8
-ON_PATH = 1e-2         # a restart within this (relative) of the traced path is not a new branch
 
 
 def _polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
@@ -95,56 +95,6 @@ def _refused(err: float, floor: float) -> bool:
     """A point's energy error above what the FRF reports: ``ENERGY_LIMIT`` plus twice the
     balance's resolution ``floor`` there (same measure)."""
     return err > ENERGY_LIMIT + 2 * floor
-
-
-class _Path:
-    """Converged points of a traced path: coefficients, frequencies, outputs, iterations, errors."""
-
-    FIELDS = ("X", "w", "Y", "its", "err", "unclosed")
-
-    def __init__(self):
-        self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
-
-    def extend_reversed(self, other: "_Path", skip_first: bool = False) -> None:
-        """Append ``other``'s points in reverse order (without its first point if ``skip_first``)."""
-        k = 1 if skip_first else 0
-        for name in self.FIELDS:
-            getattr(self, name).extend(getattr(other, name)[k:][::-1])
-
-    def passes(self, X: np.ndarray, w: float, rtol: float = ON_PATH) -> bool:
-        """Whether ``(X, w)`` lies on the traced path: within ``rtol`` (relative, 2-norm of the
-        coefficients) of the chord between two consecutive points whose frequencies bracket
-        ``w``.  A chord across two segments' ends is counted too, which can only call a new
-        point old (a restart then tries further on), never the reverse.
-
-        Parameters
-        ----------
-        X : ndarray, shape (n_coef, n)
-        w : float
-        """
-        w_all = np.asarray(self.w)
-        if w_all.size < 2:
-            return False
-        a, b = w_all[:-1], w_all[1:]
-        for i in np.flatnonzero((np.minimum(a, b) <= w) & (w <= np.maximum(a, b))):
-            span = b[i] - a[i]
-            s = 0.0 if span == 0 else (w - a[i]) / span
-            Xi = (1 - s) * self.X[i] + s * self.X[i + 1]
-            if np.linalg.norm(X - Xi) <= rtol * max(np.linalg.norm(Xi), np.linalg.norm(X)):
-                return True
-        return False
-
-    def insert(self, at: int, segments, k: int, other: "_Path", lo: int, hi: int) -> int:
-        """Insert ``other``'s points ``lo:hi`` before point ``at``, which lies in segment ``k`` of
-        ``segments`` (``[start, end)`` index ranges, shifted here); returns how many."""
-        for name in self.FIELDS:
-            getattr(self, name)[at:at] = getattr(other, name)[lo:hi]
-        n = len(other.w[lo:hi])
-        segments[k][1] += n
-        for seg in segments[k + 1:]:
-            seg[0] += n
-            seg[1] += n
-        return n
 
 
 def _widened_scale(problem, xscale: np.ndarray, X0: np.ndarray) -> np.ndarray:
@@ -244,23 +194,39 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
             break
         start = len(pts.w)
         # back from the restart towards the stop, so that only what neither side reaches is a gap
-        back = _Path()
+        back = TracedPoints()
         _trace(problem, case, back, restart[0], restart[1], restart[2], (w_from, w_hi), -1, xscale, r_scale,
                opts, progress, offset=len(pts.w), lam_step=lam_step)
         pts.extend_reversed(back, skip_first=True)
         w_reached = min(back.w) if back.w else restart[2]
         if w_reached > w_from * (1 + 1e-9):
-            gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": w_reached / (2 * np.pi), "reason": message})
+            gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": w_reached / (2 * np.pi), "reason": message,
+                         **_jump(problem.basis, pts.Y[start - 1], back.Y[-1] if back.w else pts.Y[start])})
         status, message, f2, r2 = _trace(problem, case, pts, restart[0], restart[1], restart[2], (w_lo, w_hi), +1,
                                          xscale, r_scale, opts, progress, offset=0, lam_step=lam_step)
         folds, n_rej = folds + f2, n_rej + r2
         segments.append([start, len(pts.w)])
     if gaps:
         settings["gaps"] = gaps
-        where = ", ".join(f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz" for g in gaps)
+        where = ", ".join(f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz (outputs across it: first harmonics "
+                          f"{g['h1_change']:.1e}, whole response {g['change']:.1e})" for g in gaps)
         settings["gap_warning"] = (f"the continuation stopped {len(gaps)} time(s) and was restarted further on; "
                                    f"not traced: {where} (first stop: {gaps[0]['reason']})")
     return status, message, folds, n_rej
+
+
+def _jump(basis, Ya: np.ndarray, Yb: np.ndarray) -> dict:
+    """How much the outputs (n_coef, n_out) change across a gap, relative, for the output that
+    changes most: ``h1_change`` of the first-harmonic amplitude, ``change`` of all its
+    coefficients (a gap of no width may be a jump of the mean only: a stuck slider's offset)."""
+    def rel(a, b):
+        return float(np.max(np.abs(a - b) / np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-300)))
+    h1 = 0.0
+    if 1 in basis.harmonics:
+        rows = [basis.row_of(1, "c"), basis.row_of(1, "s")]
+        h1 = rel(np.hypot(*Ya[rows]), np.hypot(*Yb[rows]))
+    size = np.maximum(np.linalg.norm(Ya, axis=0), np.linalg.norm(Yb, axis=0))
+    return {"h1_change": h1, "change": float(np.max(np.linalg.norm(Ya - Yb, axis=0) / np.maximum(size, 1e-300)))}
 
 
 def _fresh_point_past(problem, case, w_from, window, xscale, r_scale, traced):
@@ -304,7 +270,7 @@ def trace_window(problem, case, window, xscale, r_scale, opts, progress, setting
 
     Returns
     -------
-    pts : _Path
+    pts : TracedPoints
     segments : list of [start, stop]
         Index ranges of ``pts`` traced as one continuation each.
     outcome : tuple
@@ -314,7 +280,7 @@ def trace_window(problem, case, window, xscale, r_scale, opts, progress, setting
     """
     w_lo, w_hi = window
     lo, hi = w_lo / (2 * np.pi), w_hi / (2 * np.pi)
-    pts, segments = _Path(), []
+    pts, segments = TracedPoints(), []
     lam_step = _step_limit(problem, case, window)
     try:
         X0, it0 = _first_point(problem, case, w_lo, xscale, r_scale)
@@ -362,7 +328,7 @@ def _down_from_fmax(problem, case, window, xscale, r_scale, opts, progress, lam_
     Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
     if widen:
         xscale = _widened_scale(problem, xscale, Xh)
-    part = _Path()
+    part = TracedPoints()
     outcome = _trace(problem, case, part, Xh, ith, w_hi, window, -1, xscale, r_scale, opts, progress,
                      offset=offset, lam_step=lam_step)
     folded = outcome[0] == "finished" and bool(part.w) and part.w[-1] > w_lo * (1 + 1e-9)
@@ -373,7 +339,7 @@ def _from_the_top(problem, case, window, xscale, r_scale, opts, progress, lam_st
     """:func:`trace_window` when ``fmin``'s first point did not converge (``why``): the window
     from ``fmax`` down, the points returned lowest frequency first."""
     hi = window[1] / (2 * np.pi)
-    pts = _Path()
+    pts = TracedPoints()
     try:
         part, (status, message, folds, n_rej), xscale, folded = _down_from_fmax(
             problem, case, window, xscale, r_scale, opts, progress, lam_step, widen=True)
