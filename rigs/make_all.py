@@ -18,7 +18,8 @@ RIGS = {
     "railcar_wedge": ("rigs/make_railcar_wedge_model.py", ["rigs/studies/railcar_wedge_sweep.py"]),
     "blade_couple": (None, ["rigs/make_blade_couple.py"]),
     "beam_damper_beam": ("rigs/make_beam_damper_beam_model.py",
-                         ["benchmarks/beam_damper_beam_study.py", "benchmarks/brush_loops.py"]),
+                         ["benchmarks/beam_damper_beam_study.py", "benchmarks/beam_damper_beam_bar.py",
+                          "benchmarks/brush_loops.py"]),
     "upd_rig": (None, ["rigs/make_upd_rig.py", "rigs/studies/upd_ip_softening.py"]),   # the case builds its beams
 }
 
