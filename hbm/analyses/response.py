@@ -124,9 +124,11 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     freq_hz = np.array(pts_w) / (2 * np.pi)
     jumps = None
     if stable is not None:
+        t1 = time.perf_counter()
         if choose_solver(case) == "full":
             stable = confirm_unstable(case, basis, Xs, freq_hz, stable, settings)
         jumps = _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, stability_options)
+        settings["stability_seconds"] += time.perf_counter() - t1        # + Floquet checks, jumps
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
     if error_estimate and Xs.shape[0]:
         outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings, t0)
@@ -184,10 +186,12 @@ def stiff_contact_hint(case: Case) -> str:
 def _verdicts(problem, Xs, ws, segments, stability_options, settings, progress):
     """Hill's verdict (n_points,) of every point (:func:`hbm.analyses.verdicts.path_verdicts`);
     ``settings`` gains the spectra count (and how many points at rest shared one), the largest
-    growth and, where implausible, a warning."""
+    growth, the seconds spent and, where implausible, a warning."""
     if progress is not None:
         progress(len(ws), None)
+    t0 = time.perf_counter()
     stable, margin, reused = path_verdicts(problem, Xs, np.array(ws), segments, stability_options)
+    settings["stability_seconds"] = time.perf_counter() - t0
     settings["stability_spectra"] = int(np.isfinite(margin).sum()) - reused
     settings["stability_spectra_reused"] = reused
     growth = margin / np.array(ws)
