@@ -83,6 +83,7 @@ class Element:
     default_harmonics: int = 5          # H of a case that gives none (class docstring)
     default_samples_factor: int = 1     # N = factor * (power of two >= 8 H, >= 64)
     aft: str = "sampled"        # "events": the AFT calls harmonic_forces (elements.jenkins)
+    events_available: bool = False      # aft = "events" is offered (Jenkins; friction3d on (t1, n))
 
     def __init__(self, gather, params, name):
         G = np.array(gather, dtype=float, ndmin=2)

@@ -120,6 +120,11 @@ class Friction3D(Element):
         return int(self.params[4])
 
     @property
+    def events_available(self) -> bool:
+        """``aft = "events"`` exists for one tangential direction only."""
+        return self.n_tangential == 1
+
+    @property
     def kt(self):
         return float(self.params[0])
 

@@ -44,6 +44,7 @@ class Jenkins(Element):
     start_rule = START_ARGMAX
     default_harmonics = 7           # benchmarks/default_harmonics.py
     default_samples_factor = 2
+    events_available = True
 
     def __init__(self, gather, kt, slip_force, name="jenkins", aft="sampled"):
         super().__init__(gather, np.array([positive("kt", kt), non_negative("slip_force", slip_force)]), name)

@@ -161,3 +161,22 @@ def test_case_key():
     tree["element"][0]["aft"] = "exact"
     with pytest.raises(CaseError, match="aft"):
         case_from_dict(tree)
+
+
+def test_a_stopped_run_with_a_stiff_sampled_point_contact_suggests_events():
+    """The hint of a run that stops or leaves gaps names a stiff sampled (t1, n) contact, not one
+    with t2 (no event-based AFT there) nor one already on events."""
+    from hbm.analyses.response import stiff_contact_hint
+
+    def case(dofs, aft, n=2):
+        return case_from_dict({
+            "model": {"mass": np.eye(n).tolist(), "stiffness": np.eye(n).tolist()},
+            "element": [{"type": "friction3d", "dofs": dofs, "kt": 300.0, "kn": 1.0, "mu": 0.3,
+                         "normal_preload": 1.0, "aft": aft, "name": "pad"}],
+            "excitation": {"dofs": [0], "amplitude": [1.0]},
+            "analysis": {"harmonics": 3, "frequency_hz": [0.1, 0.2], "outputs": {"x": 0}},
+        })
+    hint = stiff_contact_hint(case({"t1": 0, "n": 1}, "sampled"))
+    assert "pad: kt = 300 x" in hint and 'aft = "events"' in hint
+    assert stiff_contact_hint(case({"t1": 0, "n": 1}, "events")) == ""
+    assert stiff_contact_hint(case({"t1": 0, "t2": 1, "n": 2}, "sampled", n=3)) == ""

@@ -161,16 +161,17 @@ STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
 
 
 def stiff_contact_hint(case: Case) -> str:
-    """What to try when the path stopped and sampled Jenkins contacts are stiff (``kt`` at least
-    ``STIFF_CONTACT`` times the structure's stiffness ``g K g^T / g g^T`` along the contact):
-    their switches sit on the time grid, where Newton stalls, and ``aft = "events"`` locates
-    them exactly.  Empty when there is none (or the model is not dense)."""
+    """What to try when the path stopped and sampled contacts that offer an event-based AFT
+    (Jenkins, friction3d on (t1, n)) are stiff (``kt`` at least ``STIFF_CONTACT`` times the
+    structure's stiffness ``g K g^T / g g^T`` along the first coordinate): their switches sit
+    on the time grid, where Newton stalls, and ``aft = "events"`` locates them exactly.  Empty
+    when there is none (or the model is not dense)."""
     if choose_solver(case) != "full":
         return ""
     K = case.model.K
     stiff = []
     for e in case.elements:
-        if getattr(e, "harmonic_forces", None) is None or e.aft != "sampled":
+        if not e.events_available or e.aft != "sampled":
             continue                # no event-based AFT to offer, or already on it
         g = e.gather[0]
         ks = float(g @ K @ g) / float(g @ g)
@@ -178,7 +179,7 @@ def stiff_contact_hint(case: Case) -> str:
             stiff.append(f"{e.name}: kt = {e.kt / ks:.3g} x")
     if not stiff:
         return ""
-    return (f"stiff Jenkins contacts ({', '.join(stiff)} the structure's stiffness along them) are sampled "
+    return (f"stiff contacts ({', '.join(stiff)} the structure's stiffness along them) are sampled "
             f"on the time grid, where Newton stalls at their switches: aft = \"events\" on them locates the "
             f"switches exactly (README, \"Stiff contacts\")")
 
