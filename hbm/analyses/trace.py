@@ -201,7 +201,8 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
         w_reached = min(back.w) if back.w else restart[2]
         if w_reached > w_from * (1 + 1e-9):
             gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": w_reached / (2 * np.pi), "reason": message,
-                         **_jump(problem.basis, pts.Y[start - 1], back.Y[-1] if back.w else pts.Y[start])})
+                         **_jump(problem.basis, pts.Y[start - 1], back.Y[-1] if back.w else
+                                 recover_outputs(problem, case, restart[0], restart[2]))})
         status, message, f2, r2 = _trace(problem, case, pts, restart[0], restart[1], restart[2], (w_lo, w_hi), +1,
                                          xscale, r_scale, opts, progress, offset=0, lam_step=lam_step)
         folds, n_rej = folds + f2, n_rej + r2
