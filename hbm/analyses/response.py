@@ -31,6 +31,7 @@ from hbm.analyses.problem_setup import (_first_point, _residual_scale, check_bou
                             _unknown_scale, build_problem, choose_solver, output_amplitudes,
                             recover_outputs, resolve_settings, setting_sources, solve_at)
 from hbm.analyses.result import FRFResult, OutputSeries
+from hbm.analyses.aft_retry import retry_with_events, stiff_sampled_contacts
 from hbm.analyses.stability import StabilityOptions
 from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.verdicts import landing_solver, path_verdicts
@@ -62,7 +63,9 @@ def _closure_warning(settings, unclosed, ws):
 def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transform=None,
         progress=None, options: ArclengthOptions | None = None, stability: bool = True,
         stability_options: StabilityOptions | None = None, error_estimate: bool = True) -> FRFResult:
-    """Trace the FRF of ``case``.
+    """Trace the FRF of ``case``; a run that stops or leaves gaps with stiff sampled contacts is
+    traced again on their event-based AFT and the run covering more of the window is kept
+    (:mod:`hbm.analyses.aft_retry`).
 
     Parameters
     ----------
@@ -92,6 +95,15 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         Always returned, also when the continuation fails (``status``/``message`` say why,
         with every point converged so far).
     """
+    def trace(c):
+        return _trace_frf(c, harmonics, samples, fmin, fmax, transform, progress, options, stability,
+                          stability_options, error_estimate)
+    return retry_with_events(case, trace(case), trace)
+
+
+def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, options, stability,
+               stability_options, error_estimate) -> FRFResult:
+    """One trace of the FRF of ``case`` (:func:`frf`'s parameters)."""
     h, N, lo, hi, tr = resolve_settings(case, harmonics, samples, fmin, fmax, transform)
     check_bounded(case, lo, hi)
     basis = FourierBasis(h, N)
@@ -157,26 +169,12 @@ def _add_points(problem, case, pts, segments, window, xscale, r_scale, settings,
         settings["peak_points_added"] = refine_peaks(problem, pts, segments, outputs_of, h1, xscale, r_scale)
 
 
-STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
-
-
 def stiff_contact_hint(case: Case) -> str:
     """What to try when the path stopped and sampled contacts that offer an event-based AFT
-    (Jenkins, friction3d on (t1, n)) are stiff (``kt`` at least ``STIFF_CONTACT`` times the
-    structure's stiffness ``g K g^T / g g^T`` along the first coordinate): their switches sit
-    on the time grid, where Newton stalls, and ``aft = "events"`` locates them exactly.  Empty
+    are stiff (:func:`hbm.analyses.aft_retry.stiff_sampled_contacts`): their switches sit on
+    the time grid, where Newton stalls, and ``aft = "events"`` locates them exactly.  Empty
     when there is none (or the model is not dense)."""
-    if choose_solver(case) != "full":
-        return ""
-    K = case.model.K
-    stiff = []
-    for e in case.elements:
-        if not e.events_available or e.aft != "sampled":
-            continue                # no event-based AFT to offer, or already on it
-        g = e.gather[0]
-        ks = float(g @ K @ g) / float(g @ g)
-        if ks > 0 and e.kt >= STIFF_CONTACT * ks:
-            stiff.append(f"{e.name}: kt = {e.kt / ks:.3g} x")
+    stiff = [f"{case.elements[i].name}: kt = {r:.3g} x" for i, r in stiff_sampled_contacts(case)]
     if not stiff:
         return ""
     return (f"stiff contacts ({', '.join(stiff)} the structure's stiffness along them) are sampled "

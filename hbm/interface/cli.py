@@ -212,6 +212,8 @@ def cmd_frf(args) -> int:
             print(f"  warning: {st[key]}", file=sys.stderr)
     if summary["max_energy_error"] is not None:
         print(f"  max energy-balance error {summary['max_energy_error']:.2e}")
+    if st.get("aft_retry"):
+        print(f"  note: {st['aft_retry']['note']}")
     if st.get("floquet_overrides_hz"):
         fl = st["floquet_overrides_hz"]
         print(f"  note: {len(fl)} point(s) Hill called unstable are stable by the Floquet multipliers of the "

@@ -1,0 +1,49 @@
+"""A run that stops or leaves gaps with stiff sampled contacts is traced again on their
+event-based AFT (hbm.analyses.aft_retry), and the run covering more of the window is kept."""
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import hbm
+from hbm.analyses.aft_retry import stiff_sampled_contacts, untraced_hz
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+import stiff_contacts  # noqa: E402
+
+
+def test_a_separating_point_contact_left_with_gaps_is_traced_again_with_events():
+    """N0 = 0.5, kn = 10 (kt = 100 x the unit springs): sampled, the FRF leaves two gaps (the
+    first harmonics jump by 74 % across one); the retry with events traces the whole window
+    and is kept.  The case itself is not changed."""
+    case = stiff_contacts.point_contact(0.5, 10.0)
+    res = hbm.frf(case, stability=False, error_estimate=False)
+    r = res.settings["aft_retry"]
+    assert res.status == "finished" and not res.settings.get("gaps")
+    assert r["kept"] == "events" and r["untraced_hz_events"] == 0.0 and r["untraced_hz_sampled"] > 1e-3
+    assert "friction3d" in r["note"] and case.elements[0].aft == "sampled"
+    assert np.all(res.energy_error < 1e-8)
+
+
+def test_no_retry_when_the_run_finishes_or_no_contact_is_stiff():
+    res = hbm.frf(stiff_contacts.point_contact(50.0, 1e3), stability=False, error_estimate=False)
+    assert res.status == "finished" and "aft_retry" not in res.settings
+    soft = hbm.case_from_dict({
+        "model": {"mass": [[1.0]], "stiffness": [[1.0]], "damping": [[0.02]]},
+        "element": [{"type": "jenkins", "dofs": [0], "kt": 50.0, "slip_force": 0.5}],
+        "excitation": {"dofs": [0], "amplitude": [1.0]},
+        "analysis": {"harmonics": 3, "frequency_hz": [0.1, 0.2], "outputs": {"x": 0}},
+    })
+    assert stiff_sampled_contacts(soft) == []
+
+
+@pytest.mark.parametrize("freqs, gaps, expected", [
+    ([1.0, 2.0, 3.0], [], 1.5),                     # from 1 (traced down from the top) to 3 of 0.5..4
+    ([0.5, 4.0], [{"from_hz": 1.0, "to_hz": 1.5}], 0.5),               # one gap
+    ([], [], 3.5),                                                     # nothing traced
+])
+def test_untraced_width(freqs, gaps, expected):
+    res = SimpleNamespace(freq_hz=np.array(freqs), settings={"fmin_hz": 0.5, "fmax_hz": 4.0, "gaps": gaps})
+    assert untraced_hz(res) == pytest.approx(expected)
