@@ -39,11 +39,22 @@ def test_no_retry_when_the_run_finishes_or_no_contact_is_stiff():
     assert stiff_sampled_contacts(soft) == []
 
 
-@pytest.mark.parametrize("freqs, gaps, expected", [
-    ([1.0, 2.0, 3.0], [], 1.5),                     # from 1 (traced down from the top) to 3 of 0.5..4
-    ([0.5, 4.0], [{"from_hz": 1.0, "to_hz": 1.5}], 0.5),               # one gap
-    ([], [], 3.5),                                                     # nothing traced
+@pytest.mark.parametrize("freqs, segments, expected", [
+    ([1.0, 2.0, 3.0], [[0, 3]], 1.5),                        # from 1 (traced down from the top) to 3 of 0.5..4
+    ([0.5, 1.0, 1.5, 4.0], [[0, 2], [2, 4]], 0.5),           # a gap 1.0..1.5 between two segments
+    ([0.5, 0.8, 0.6, 2.0, 4.0], [[0, 3], [3, 5]], 1.2),      # folded back at 0.8, traced from the top to 2.0
+    ([], [], 3.5),                                           # nothing traced
 ])
-def test_untraced_width(freqs, gaps, expected):
-    res = SimpleNamespace(freq_hz=np.array(freqs), settings={"fmin_hz": 0.5, "fmax_hz": 4.0, "gaps": gaps})
+def test_untraced_width(freqs, segments, expected):
+    res = SimpleNamespace(freq_hz=np.array(freqs), settings={"fmin_hz": 0.5, "fmax_hz": 4.0, "segments": segments})
     assert untraced_hz(res) == pytest.approx(expected)
+
+
+def test_a_long_first_run_is_not_repeated_and_keeps_its_hint(monkeypatch):
+    """Over ``RETRY_SECONDS`` (here 0) the run is returned as it is: gaps stated, and the hint
+    names the stiff contact and ``aft = "events"``."""
+    import hbm.analyses.aft_retry as retry
+    monkeypatch.setattr(retry, "RETRY_SECONDS", 0.0)
+    res = hbm.frf(stiff_contacts.point_contact(0.5, 10.0), stability=False, error_estimate=False)
+    assert "aft_retry" not in res.settings and res.settings.get("gaps")
+    assert 'aft = "events"' in res.settings["contact_hint"]

@@ -7,9 +7,12 @@ elements that offer an event-based AFT (``events_available``: Jenkins, friction3
 compute the same law exactly from its events.  So when an FRF with such contacts stops or
 leaves gaps, :func:`retry_with_events` traces the window again with ``aft = "events"`` on
 them and keeps the run that covers more of it: a finished run before a stopped one, then the
-smaller untraced width (gaps, and the window's ends a stopped run did not reach), the first
-run on a tie.  ``settings["aft_retry"]`` says what was tried, what each run left untraced
-and which was kept.
+untraced width (gaps, the window's ends a stopped run did not reach, a hole between a
+folded-back start and a trace from the top) if it is at most ``SHARE`` of the first run's;
+else the first run.  ``settings["aft_retry"]`` says what was tried, what each run left untraced and
+which was kept.  A first run longer than ``RETRY_SECONDS`` is not repeated (it would double a
+long run, e.g. the railcar rig's 150 s for 0.005 Hz more): its ``contact_hint`` says what to
+try.
 """
 from __future__ import annotations
 
@@ -17,6 +20,8 @@ import copy
 import dataclasses
 
 STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
+RETRY_SECONDS = 60.0        # a first run longer than this is not repeated (its hint says how)
+SHARE = 0.9                 # the events run is kept if it leaves at most this share untraced
 
 
 def stiff_sampled_contacts(case) -> list:
@@ -39,12 +44,20 @@ def stiff_sampled_contacts(case) -> list:
 
 
 def untraced_hz(res) -> float:
-    """Width of the window a run did not trace: its gaps, and the ends it did not reach."""
+    """Width of the window (Hz) that no traced segment of a run covers: its gaps, the ends it
+    did not reach, and the hole a run leaves when it folds back and is traced from the top."""
     s = res.settings
-    width = sum(g["to_hz"] - g["from_hz"] for g in s.get("gaps", []))
-    if res.freq_hz.size == 0:
-        return float(s["fmax_hz"] - s["fmin_hz"])
-    return float(width + (s["fmax_hz"] - res.freq_hz.max()) + (res.freq_hz.min() - s["fmin_hz"]))
+    lo, hi = float(s["fmin_hz"]), float(s["fmax_hz"])
+    f = res.freq_hz
+    spans = sorted((max(float(f[a:b].min()), lo), min(float(f[a:b].max()), hi))
+                   for a, b in s.get("segments", [[0, f.size]]) if b > a)
+    covered, end = 0.0, lo
+    for a, b in spans:
+        a = max(a, end)
+        if b > a:
+            covered += b - a
+            end = b
+    return hi - lo - covered
 
 
 def _events_case(case, stiff):
@@ -69,7 +82,7 @@ def retry_with_events(case, res, trace):
     trace : callable
         ``trace(case) -> FRFResult`` with the same settings.
     """
-    if res.status == "finished" and not res.settings.get("gaps"):
+    if (res.status == "finished" and not res.settings.get("gaps")) or res.solve_seconds > RETRY_SECONDS:
         return res
     stiff = stiff_sampled_contacts(case)
     if not stiff:
@@ -77,7 +90,8 @@ def retry_with_events(case, res, trace):
     names = ", ".join(case.elements[i].name for i, _ in stiff)
     alt = trace(_events_case(case, stiff))
     first, second = untraced_hz(res), untraced_hz(alt)
-    better = (alt.status == "finished", -second) > (res.status == "finished", -first)
+    done, done_alt = res.status == "finished", alt.status == "finished"
+    better = done_alt > done or (done_alt == done and second < SHARE * first)
     kept, other = (alt, res) if better else (res, alt)
     kept.settings["aft_retry"] = {
         "contacts": names, "untraced_hz_sampled": first, "untraced_hz_events": second,
