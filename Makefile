@@ -11,9 +11,10 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
-	@echo "compiling the numerical kernels of Jenkins and friction3d contacts (about 30 s, once)"
+	@echo "compiling the numerical kernels of Jenkins and friction3d contacts (about 45 s, once)"
 	$(BIN)/hbm frf rigs/sdof_jenkins.toml -o $(VENV)/warmup > /dev/null 2>&1
 	$(BIN)/hbm frf rigs/inclined_contact.toml -o $(VENV)/warmup > /dev/null 2>&1
+	$(BIN)/python -c "from elements.friction2d_events import compile_kernels; compile_kernels()"
 	touch $(STAMP)
 
 setup: $(STAMP)

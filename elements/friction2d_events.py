@@ -313,3 +313,18 @@ def contact_harmonics(h, is_sin, U, p, grid, gx, gw, F, J):
     if h[0] == 0:
         F[0, 1] -= max(N0, 0.0)
     return True
+
+
+def compile_kernels() -> None:
+    """Compile the event-based AFT kernels (this module's and the Jenkins element's) once, on
+    a small slipping loop, so that a run which switches to them (``hbm.analyses.aft_retry``)
+    does not compile mid-run; ``make setup`` calls it."""
+    from .jenkins_events import gauss_table, jenkins_harmonics, row_kinds
+    h, s = row_kinds(np.array([0, 1, 1, 2, 2, 3, 3]))
+    gx, gw = gauss_table(3)
+    U = np.zeros((h.size, 2))
+    U[1] = [1.0, 0.2]
+    F, J = np.empty((h.size, 2)), np.empty((h.size, 2, h.size, 2))
+    contact_harmonics(h, s, U, np.array([10.0, 1.0, 0.3, 1.0]), 64, gx, gw, F, J)
+    jenkins_harmonics(h, s, np.ascontiguousarray(U[:, 0]), 10.0, 0.3, 64, gx, gw, F[:, 0].copy(),
+                      np.empty((h.size, h.size)))
