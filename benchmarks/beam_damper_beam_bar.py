@@ -137,8 +137,7 @@ def main(argv=None):
     k_bar, c_bar, _ = bar_damper_function(k_b, k_w, slip, amps)
     summary = {"load_N": LOAD, "slip_force_N": slip, "brush_k_w": K_BODY, "bar_k_b": k_b, "bar_k_w": k_w,
                **compare(amps, k_br, c_br, k_bar, c_bar, use)}
-    for key in ("stiffness_difference_over_k_w_range",):
-        summary[key] = [v / K_BODY for v in summary[key]]
+    summary["stiffness_difference_over_k_w_range"] = [v / K_BODY for v in summary["stiffness_difference_over_k_w_range"]]
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     ax[0].semilogx(amps * 1e6, k_br / 1e6, label="Brush (the rig, r = 2.6 mm)")
     ax[0].semilogx(amps * 1e6, k_bar / 1e6, "--", label=f"Bar, fitted: EA/l = {k_b / 1e6:.3g}, k_w = {k_w / 1e6:.3g} N/um")

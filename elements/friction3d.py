@@ -2,20 +2,15 @@
 separation (law in laws/friction3d.py)."""
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .base import Element
 from .friction2d_events import contact_harmonics
-from .jenkins_events import gauss_table
+from .jenkins_events import gauss_rules
 from .keys import coordinate_rows, require_keys, finite, positive, non_negative
 from .law_march import START_PRINCIPAL, CLOSE_NEWTON
 from .laws.friction3d import n_states
 from .laws.registry import FRICTION3D
-
-
-_gauss = functools.lru_cache(maxsize=8)(gauss_table)
 
 
 class Friction3D(Element):
@@ -172,7 +167,7 @@ class Friction3D(Element):
         nc = h.size
         F, J = np.empty((nc, 2)), np.empty((nc, 2, nc, 2))
         h_max = int(h.max())
-        gx, gw = _gauss(h_max)
+        gx, gw = gauss_rules(h_max)
         if not contact_harmonics(h, is_sin, np.ascontiguousarray(U, dtype=float), self.params[:4].copy(),
                                  16 * max(h_max, 4), gx, gw, F, J):
             return None

@@ -1,17 +1,13 @@
 """The jenkins element class: parameters, case keys and coordinates (law in laws/jenkins.py)."""
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .base import Element, slider_summary
 from .keys import coordinate_rows, require_keys, positive, non_negative
 from .laws.registry import JENKINS
 from .law_march import START_ARGMAX
-from .jenkins_events import gauss_table, jenkins_harmonics
-
-_gauss = functools.lru_cache(maxsize=8)(gauss_table)
+from .jenkins_events import gauss_rules, jenkins_harmonics
 
 
 class Jenkins(Element):
@@ -91,7 +87,7 @@ class Jenkins(Element):
         nc = h.size
         F, J = np.empty(nc), np.empty((nc, nc))
         h_max = int(h.max())
-        gx, gw = _gauss(h_max)
+        gx, gw = gauss_rules(h_max)
         if not jenkins_harmonics(h, is_sin, np.ascontiguousarray(U[:, 0]), self.kt, self.slip_force,
                                  16 * max(h_max, 4), gx, gw, F, J):
             return None

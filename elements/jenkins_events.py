@@ -39,6 +39,7 @@ never slips (stuck for the whole period, a non-unique state) is left to the samp
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numba as nb
@@ -153,6 +154,9 @@ def gauss_table(h_max: int):
     for n in range(1, n_max + 1):
         gx[n, :n], gw[n, :n] = np.polynomial.legendre.leggauss(n)
     return gx, gw
+
+
+gauss_rules = functools.lru_cache(maxsize=8)(gauss_table)    # one table per H, shared by the elements
 
 
 @nb.njit(cache=True)

@@ -260,13 +260,13 @@ def main():
         idx = res["case"].model.dof_index["dL.x"]
         a = harmonic_amplitudes(res["run"].history.q[-SHOW * res["run"].steps:, idx], res["run"].steps)
         print("    damper harmonics 1..11 relative to the 1st: " + " ".join(f"{v / a[0]:.1e}" for v in a))
-        q = res["run"].history.q
+        steps = res["run"].steps
         for dof in ("dL.x", "tip.x"):
-            lines = [line_near(q[:, res["case"].model.dof_index[dof]], res["run"].steps, f) for f in (45.7, 234.2)]
+            x = res["run"].history.q[:, res["case"].model.dof_index[dof]]
+            a1 = harmonic_amplitudes(x[-SHOW * steps:], steps)[0]
+            lines = (line_near(x, steps, f) for f in (45.7, 234.2))
             print(f"    {dof} lines between the harmonics (last 100 periods): "
-                  + ", ".join(f"{f:.2f} Hz {a / a_1:.1e} of the 1st" for (f, a), a_1 in
-                              zip(lines, [harmonic_amplitudes(q[-SHOW * res['run'].steps:,
-                                          res['case'].model.dof_index[dof]], res['run'].steps)[0]] * 2)))
+                  + ", ".join(f"{f:.2f} Hz {a / a1:.1e} of the 1st" for f, a in lines))
     plot_regimes(reg, fig_dir / "cross_beam_regimes.png")
     rows = energy_curves()
     write_csv(out_dir / "cross_beam_energy.csv", rows)
