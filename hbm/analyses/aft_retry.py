@@ -44,20 +44,10 @@ def stiff_sampled_contacts(case) -> list:
 
 
 def untraced_hz(res) -> float:
-    """Width of the window (Hz) that no traced segment of a run covers: its gaps, the ends it
-    did not reach, and the hole a run leaves when it folds back and is traced from the top."""
-    s = res.settings
-    lo, hi = float(s["fmin_hz"]), float(s["fmax_hz"])
-    f = res.freq_hz
-    spans = sorted((max(float(f[a:b].min()), lo), min(float(f[a:b].max()), hi))
-                   for a, b in s.get("segments", [[0, f.size]]) if b > a)
-    covered, end = 0.0, lo
-    for a, b in spans:
-        a = max(a, end)
-        if b > a:
-            covered += b - a
-            end = b
-    return hi - lo - covered
+    """Width of the window (Hz) that no traced segment of a run covers
+    (:func:`hbm.analyses.time_fill.untraced_stretches`)."""
+    from hbm.analyses.time_fill import untraced_stretches
+    return sum(b - a for a, b in untraced_stretches(res))
 
 
 def _events_case(case, stiff):

@@ -45,13 +45,13 @@ def _positive_int(text):
     return v
 
 
-def _positive_float(text):
+def _positive_float(text, zero=False):
     try:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not v > 0 or v == float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    if not (v > 0 or (zero and v == 0)) or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a {'non-negative' if zero else 'positive'} number, got {text!r}")
     return v
 
 
@@ -79,6 +79,9 @@ def build_parser():
                    help="raise the harmonics, for the path and then point by point, until every point's estimated "
                         "error of the first harmonic is below TOL (column H: each point's harmonics; default "
                         "1e-2 unless --harmonics is given)")
+    f.add_argument("--time-fill", type=lambda t: _positive_float(t, zero=True), default=30.0, metavar="SECONDS",
+                   help="where the continuation leaves the window untraced, run time simulations there for at "
+                        "most SECONDS (frf_timedomain.csv; default 30, 0: none)")
     _add_analysis_options(f)
     t = sub.add_parser("timesim", help="time-domain reference at one frequency (steady state or transient)")
     t.add_argument("case", help="case file (TOML)")
@@ -129,38 +132,31 @@ def _check_outdir(path):
         raise CaseError(f"-o {path}: cannot write results there ({exc.strerror or exc})") from None
 
 
-def _defaults_note(st) -> str:
-    """`` (element defaults: H, N)`` for the settings that were not given, else empty."""
-    d = [k for k, s in (("H", "harmonics_source"), ("N", "time_samples_source")) if st.get(s) == "default"]
-    return f" (element defaults: {', '.join(d)})" if d else ""
+def _time_fill(case, res, args) -> bool:
+    """Time-simulate what the run left untraced (``--time-fill`` seconds; the HBM files are
+    already on disk); True when points were added to ``res.settings``."""
+    from hbm.analyses.time_fill import fill_untraced
+    from hbm.interface.progress import CountProgress
+    if args.time_fill <= 0 or (res.status == "finished" and not res.settings.get("gaps")):
+        return False
+    bar = None if args.quiet else CountProgress(1, "point", "time domain (untraced stretches)")
 
-
-def _print_adaptive(a: dict, explicit: bool) -> None:
-    """What the harmonics' tolerance did: printed when asked for, or when it did anything."""
-    pts = a["points"]
-    if not explicit and len(a["tried"]) == 1 and not pts["levels"]:
-        return
-    if not a["checked"]:
-        print(f"  harmonics for --tol {a['tol']:g}: not checked (no point's error could be estimated)")
-        return
-    steps = " -> ".join(f"H={t['H']} (largest estimate {t['max_error']:.1e}, {t['share_above']:.0%} of points "
-                        f"above, {t['seconds']:.2f} s)" for t in a["tried"])
-    ref = ", ".join(f"{v['points']} at H={v['H']}" for v in pts["levels"]) or "none"
-    print(f"  harmonics for --tol {a['tol']:g}: path traced at {steps}; points refined: {ref} "
-          f"({pts['seconds']:.2f} s)" + ("" if a["met"] else
-                                         f": tolerance NOT met (largest estimate {a['max_error']:.1e}, "
-                                         f"{pts['left_above']} points above, {pts['failed']} refinements failed)"))
-    if pts.get("failed_hz"):
-        where = ", ".join(f"{f:.6g} Hz (H = {h})" for f, h in pts["failed_hz"][:5])
-        print(f"  note: the richer solve did not converge at {where}: those points keep their last "
-              f"solution and estimate (near a fold, or a stiff contact's switch: see contact_hint or the "
-              f"README's \"Stiff contacts\"; a larger --tol accepts them)", file=sys.stderr)
+    def progress(done, total):
+        if bar is not None:
+            bar.bar.total = total
+            bar(done)
+    try:
+        return fill_untraced(case, res, budget=args.time_fill, progress=progress) is not None
+    finally:
+        if bar is not None:
+            bar.close()
 
 
 def cmd_frf(args) -> int:
     from hbm.analyses.adaptive import DEFAULT_TOL, frf_to_tolerance
     from hbm.analyses.response import frf
-    from hbm.interface.report import describe_folds, write_frf
+    from hbm.interface.frf_console import print_frf
+    from hbm.interface.report import write_frf
     from hbm.interface.progress import FRFProgress, compile_notice
     case = load_case(args.case)
     _check_outdir(args.out)
@@ -180,50 +176,11 @@ def cmd_frf(args) -> int:
         if bar is not None:
             bar.close()
     summary = write_frf(case, res, args.out)
-    print(f"{case.name}: {summary['n_points']} points, {summary['newton_iterations']} Newton iterations, "
-          f"{summary['solve_seconds']:.3f} s, H={res.settings['harmonics'][-1]}, N={res.settings['time_samples']}"
-          + _defaults_note(res.settings))
-    st = res.settings
-    if st.get("adaptive"):
-        _print_adaptive(st["adaptive"], explicit=args.tol is not None)
-    if st.get("solver") == "condensed":
-        print(f"  condensed solver: {st['n_dof']} DOFs -> {st['contact_coordinates']} contact coordinates, "
-              f"{st['modes']} modes (to {st['highest_kept_mode_hz']:.6g} Hz), reduction {st['reduction_seconds']:.3f} s"
-              + (" (cached)" if st.get("reduction_cached") else ""))
-        if st.get("modes_added"):
-            from hbm.model.mode_cover import MARGIN
-            print(f"  warning: {st['modes_requested']} modes stop below {MARGIN:g} x fmax: added {st['modes_added']} "
-                  f"(the omitted modes would respond inside the window)", file=sys.stderr)
-    for name, pk in summary["peaks"].items():
-        for p in pk:
-            print(f"  peak {name}: {p['amplitude']:.6g} at {p['freq_hz']:.6g} Hz")
-    if summary["folds"]:
-        print("  " + describe_folds(summary["folds"], (st["fmin_hz"], st["fmax_hz"])))
-    for name, jumps in (summary["jumps"] or {}).items():
-        for way in ("up", "down"):
-            for j in jumps[way]:
-                after = ("no stable branch (no stable point to land on in the traced path: "
-                         "check with hbm timesim)" if j["amplitude_after"] is None else f"{j['amplitude_after']:.6g}")
-                print(f"  jump {name} (sweep {way}) at {j['from_hz']:.6g} Hz: "
-                      f"{j['amplitude_before']:.6g} -> {after}")
-    for key in ("gap_warning", "contact_hint", "stability_warning", "closure_warning", "truncation_warning",
-                "harmonics_note"):
-        if st.get(key):
-            print(f"  warning: {st[key]}", file=sys.stderr)
-    if summary["max_energy_error"] is not None:
-        print(f"  max energy-balance error {summary['max_energy_error']:.2e}")
-    if st.get("aft_retry"):
-        print(f"  note: {st['aft_retry']['note']}")
-    if st.get("floquet_overrides_hz"):
-        fl = st["floquet_overrides_hz"]
-        print(f"  note: {len(fl)} point(s) Hill called unstable are stable by the Floquet multipliers of the "
-              f"time-domain period map (at {', '.join(f'{f:.6g}' for f in fl[:5])} Hz); the verdicts are Floquet's")
-    if st.get("stuck_points"):
-        print(f"  note: at {st['stuck_points']} points a contact sticks for the whole period: its slider offset, "
-              f"hence the mean and max |y|, is one of a family of periodic solutions (column stuck_contacts)")
-    for name, v in (st.get("error_estimate") or {}).get("max", {}).items():
-        print(f"  largest estimated error of {name}_h1 {v['error']:.1e} at {v['freq_hz']:.6g} Hz (harmonic truncation)")
-    print(f"  wrote {args.out}/frf.csv, frf.png, summary.json")
+    if _time_fill(case, res, args):
+        summary = write_frf(case, res, args.out)
+    print_frf(case, res, summary, explicit_tol=args.tol is not None)
+    print(f"  wrote {args.out}/frf.csv, frf.png, summary.json"
+          + (", frf_timedomain.csv" if res.settings.get("time_fill") else ""))
     if not res.ok:
         sys.stderr.write(f"hbm: solver stopped: {res.message}\n")
         return 1

@@ -7,7 +7,8 @@ output; m under support motion, so the ratio is a transmissibility).  Points tha
 method finds unstable are drawn dotted and grey-backed; the jumps of slow sweeps are arrows
 (up-sweep red, down-sweep blue; a jump with no stable landing ends in a cross); a shaded
 band is the estimated truncation error of the first harmonic (:mod:`hbm.analyses.truncation`); folds are
-faint vertical lines.  A panel below draws that estimated error on a log scale with 1 %
+faint vertical lines; diamonds are time-domain points where the continuation left the window
+untraced (:mod:`hbm.analyses.time_fill`; filled: first harmonic, open: max).  A panel below draws that estimated error on a log scale with 1 %
 marked; a lower panel, when the case asks for element outputs
 (``"ELEMENT.QUANTITY"``, e.g. a contact's slip fraction or normal load), draws them against
 the same frequency axis.
@@ -65,6 +66,20 @@ def _draw_jumps(ax, jumps, scale):
                         arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.5})
 
 
+def _draw_fill(ax, points, names, colours, scale):
+    """Time-domain points of an untraced stretch (:mod:`hbm.analyses.time_fill`): per output the
+    first harmonic (filled diamonds) and max (open diamonds), at the points that settled."""
+    ok = [p for p in points if p["ok"]]
+    if not ok:
+        return
+    f = [p["freq_hz"] for p in ok]
+    for k, name in enumerate(names):
+        c = colours[k % len(colours)]
+        ax.plot(f, [p["h1"][name] / scale for p in ok], "D", ms=4, color=c)
+        ax.plot(f, [p["max"][name] / scale for p in ok], "D", ms=4, mfc="none", color=c)
+    ax.plot([], [], "D", ms=4, color="0.3", label="time domain (untraced by HBM)")
+
+
 def _draw_errors(ax, freq, errs, colours, tol=None):
     """Estimated relative error of each output's first harmonic, log scale, 1 % marked (and the
     harmonics' tolerance ``tol`` when the run had one other than 1 %)."""
@@ -117,6 +132,8 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
                      getattr(o, "err", None))
         if jumps and jumps.get(name):
             _draw_jumps(ax, jumps[name], scale)
+    if res.settings.get("time_fill"):
+        _draw_fill(ax, res.settings["time_fill"]["points"], list(res.outputs), colours, scale)
     if res.stable is not None and not stable.all():
         ax.plot([], [], "k:", lw=2.0, label="unstable (Hill)")
     if jumps and any(j.get(w) for j in jumps.values() for w in JUMP_COLOURS):

@@ -114,6 +114,21 @@ def write_csv(res, path: Path) -> None:
         fh.write(format_csv(res))
 
 
+def format_fill_csv(record: dict, names) -> str:
+    """The ``frf_timedomain.csv`` text of a time fill (:func:`hbm.analyses.time_fill.fill_untraced`):
+    one row per simulated frequency, amplitudes empty where the simulation did not settle."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")]
+               + ["error_estimate", "periods", "seconds", "periodic", "message"])
+    for p in record["points"]:
+        amps = [f"{p[k][n]:.10g}" if p["ok"] else "" for n in names for k in ("h1", "max")]
+        w.writerow([f"{p['freq_hz']:.10g}"] + amps
+                   + [f"{p['error_estimate']:.3g}" if p["ok"] else "", p.get("periods", ""),
+                      f"{p['seconds']:.3g}", int(p["ok"]), p["message"]])
+    return buf.getvalue()
+
+
 def _jumps(res):
     """The result's predicted jumps, or computed from the path (interpolated landings)."""
     if res.stable is None:
@@ -163,6 +178,9 @@ def write_frf(case, res, outdir, extra=None) -> dict:
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     write_csv(res, out / "frf.csv")
+    fill = res.settings.get("time_fill")
+    if fill:
+        (out / "frf_timedomain.csv").write_text(format_fill_csv(fill, list(res.outputs)))
     summary = summary_dict(case, res, extra)
     with open(out / "summary.json", "w") as fh:
         json.dump(summary, fh, indent=2)

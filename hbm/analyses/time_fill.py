@@ -1,0 +1,215 @@
+r"""Time-domain answers where the harmonic balance left the window untraced.
+
+When the continuation stops short or restarts past a gap, the stretches of
+:math:`[f_{min}, f_{max}]` that no traced segment covers have no HBM answer.  Where the
+response there cannot be represented with the retained harmonics (a contact that sticks for
+most of the period and slips in short bursts: the truncated displacement rings by more than
+the contact's stick range :math:`2 F_s / k_t`, so the penalty law chatters and Newton stalls),
+more continuation cannot help, but the time integration can: :func:`fill_untraced` runs the
+steady-state time simulation (:func:`hbm.timedomain.timesim.timesim`, Newmark with located
+switches and an ``n`` / ``2 n`` error estimate) at points spread over the untraced stretches,
+within a time budget.  The points are kept apart from the HBM path (``settings["time_fill"]``,
+``frf_timedomain.csv``, markers in ``frf.png``): they carry no harmonic coefficients.
+
+A stretch is ``[a, b]`` with ``a`` and ``b`` the ends of the traced spans around it (or the
+window's ends); its points sit at the window's end when the stretch reaches it, else at
+interior fractions ``k / (m + 1)``.  Stretches narrower than ``MIN_WIDTH`` of the window (a
+corner of the path, e.g. a stuck slider's offset that jumps when it starts to slip) get none.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+MIN_WIDTH = 1e-4        # stretches narrower than this share of the window get no point
+BUDGET_SECONDS = 30.0   # time simulations stop being started after this
+MAX_POINTS = 12         # points over all stretches
+POINT_SHARE = 0.25      # a point that has not settled after this share of the budget is abandoned
+LARGE_ERROR = 0.1       # a traced point next to a stretch estimated this far off is named
+
+
+def untraced_stretches(res) -> list:
+    """``(a, b)`` (Hz) of the window that no traced segment of ``res`` covers: its gaps, the
+    ends it did not reach, the hole a run leaves when it folds back and is traced from the top.
+
+    Parameters
+    ----------
+    res : FRFResult
+
+    Returns
+    -------
+    list of (float, float)
+        Sorted, disjoint, inside ``[fmin_hz, fmax_hz]``.
+    """
+    s = res.settings
+    lo, hi = float(s["fmin_hz"]), float(s["fmax_hz"])
+    f = res.freq_hz
+    spans = sorted((max(float(f[a:b].min()), lo), min(float(f[a:b].max()), hi))
+                   for a, b in s.get("segments", [[0, f.size]]) if b > a)
+    out, end = [], lo
+    for a, b in spans:
+        if a > end:
+            out.append((end, a))
+        end = max(end, b)
+    if hi > end:
+        out.append((end, hi))
+    return out
+
+
+def fill_frequencies(stretches: list, window: tuple, max_points: int = MAX_POINTS) -> list:
+    """Frequencies (Hz) to simulate in ``stretches``: shares of ``max_points`` in proportion to
+    width (at least one each), at the window's end where a stretch reaches it, else inside.
+
+    Parameters
+    ----------
+    stretches : list of (float, float)
+    window : (float, float)
+        ``(fmin, fmax)``, Hz.
+    max_points : int
+
+    Returns
+    -------
+    list of list of float
+        One list per stretch (empty for a stretch narrower than ``MIN_WIDTH`` of the window).
+    """
+    lo, hi = window
+    wide = [(a, b) for a, b in stretches if b - a > MIN_WIDTH * (hi - lo)]
+    total = sum(b - a for a, b in wide)
+    out = []
+    for a, b in stretches:
+        if (a, b) not in wide:
+            out.append([])
+            continue
+        m = max(1, int(round(max_points * (b - a) / total)))
+        if a <= lo:             # the window's start was not reached: simulate at it
+            out.append([a + (b - a) * k / m for k in range(m)])
+        elif b >= hi:
+            out.append([b - (b - a) * k / m for k in range(m)][::-1])
+        else:
+            out.append([a + (b - a) * k / (m + 1) for k in range(1, m + 1)])
+    return out
+
+
+def _neighbour_errors(res, a: float, b: float) -> list:
+    """Largest estimated first-harmonic error (over the outputs) of the traced points nearest
+    to ``a`` and ``b``, for those above ``LARGE_ERROR``: ``[(freq_hz, error), ...]``."""
+    errs = [o.err for o in res.outputs.values() if o.err is not None]
+    if not errs or res.freq_hz.size == 0:
+        return []
+    worst = np.nanmax(np.array(errs), axis=0)
+    out = []
+    for f in {a, b}:
+        i = int(np.argmin(np.abs(res.freq_hz - f)))
+        if abs(res.freq_hz[i] - f) <= 1e-9 * max(abs(f), 1.0) and worst[i] > LARGE_ERROR:
+            out.append((float(res.freq_hz[i]), float(worst[i])))
+    return out
+
+
+class _OutOfTime(Exception):
+    """Raised from a time simulation's progress callback past its deadline."""
+
+
+def _simulate(case, f: float, seconds: float, why: str) -> dict:
+    """One steady-state time simulation at ``f`` Hz as a JSON-friendly record, abandoned
+    (``ok`` False) after about ``seconds`` (``why``: what limited them)."""
+    from hbm.timedomain.timesim import timesim
+    t0 = time.perf_counter()
+
+    def watch(periods, change):
+        if time.perf_counter() - t0 > seconds:
+            raise _OutOfTime(f"not periodic after {periods} periods in {seconds:.1f} s ({why})")
+    try:
+        r = timesim(case, f, progress=watch)
+    except (RuntimeError, _OutOfTime) as exc:
+        return {"freq_hz": f, "ok": False, "message": str(exc), "seconds": time.perf_counter() - t0}
+    return {"freq_hz": f, "ok": bool(r.converged), "h1": dict(r.h1), "max": dict(r.max),
+            "error_estimate": float(r.error_estimate), "periods": int(r.periods),
+            "seconds": time.perf_counter() - t0,
+            "message": "" if r.converged else f"not periodic to tolerance after {r.periods} periods"}
+
+
+def spread_order(n: int) -> list:
+    """Indices ``0 .. n-1`` in an order that covers the range early (bit-reversed), so that a
+    budget that runs out leaves the simulated points spread out."""
+    bits = max(1, (n - 1).bit_length())
+    keys = [int(format(i, f"0{bits}b")[::-1], 2) for i in range(n)]
+    return sorted(range(n), key=lambda i: keys[i])
+
+
+def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = MAX_POINTS,
+                  progress=None) -> dict | None:
+    """Time-simulate the stretches of the window that ``res`` left untraced (module doc) and
+    record them in ``res.settings["time_fill"]``.
+
+    Parameters
+    ----------
+    case : Case
+    res : FRFResult
+    budget : float
+        No simulation is started once this many seconds have been spent.
+    max_points : int
+    progress : callable, optional
+        ``progress(done, total)`` after each simulation.
+
+    Returns
+    -------
+    dict or None
+        ``stretches`` (each ``a_hz``, ``b_hz``, ``neighbour_errors``), ``points`` (each
+        ``freq_hz``, ``ok``, per output ``h1`` and ``max``, ``error_estimate``, ``periods``,
+        ``seconds``, ``message``), ``skipped`` (frequencies not simulated for the budget),
+        ``seconds``, ``note``; None when the run left nothing wide enough untraced or its
+        model is not simulated here (the condensed solver's models: their time integration
+        runs on every DOF).
+    """
+    from hbm.analyses.problem_setup import choose_solver
+    if res.freq_hz.size == 0 or choose_solver(case) != "full":
+        return None
+    window = (float(res.settings["fmin_hz"]), float(res.settings["fmax_hz"]))
+    stretches = untraced_stretches(res)
+    freqs = fill_frequencies(stretches, window, max_points)
+    todo = [f for fs in freqs for f in fs]
+    if not todo:
+        return None
+    t0, points, skipped = time.perf_counter(), [], []
+    for i in spread_order(len(todo)):
+        left = budget - (time.perf_counter() - t0)
+        if left <= 0:
+            skipped.append(todo[i])
+            continue
+        share = POINT_SHARE * budget
+        why = "a point's share of the budget" if share < left else "the budget ran out"
+        points.append(_simulate(case, todo[i], min(left, share), why))
+        if progress is not None:
+            progress(len(points), len(todo))
+    points.sort(key=lambda p: p["freq_hz"])
+    skipped.sort()
+    record = {"stretches": [{"a_hz": a, "b_hz": b, "neighbour_errors": _neighbour_errors(res, a, b)}
+                            for (a, b), fs in zip(stretches, freqs) if fs],
+              "points": points, "skipped": skipped, "seconds": time.perf_counter() - t0, "budget": budget}
+    record["note"] = fill_note(record, res.settings.get("harmonics", []))
+    res.settings["time_fill"] = record
+    return record
+
+
+def fill_note(record: dict, harmonics) -> str:
+    """One line: what was simulated where, what the traced points next to it say, what failed."""
+    ok = [p for p in record["points"] if p["ok"]]
+    parts = [f"{a['a_hz']:.6g}..{a['b_hz']:.6g} Hz" for a in record["stretches"]]
+    note = (f"untraced {', '.join(parts)}: {len(ok)} of {len(record['points']) + len(record['skipped'])} "
+            f"time-domain points (hbm timesim, {record['seconds']:.1f} s) in frf_timedomain.csv")
+    if ok:
+        note += f", estimated error up to {max(p['error_estimate'] for p in ok):.1e}"
+    bad = [p for p in record["points"] if not p["ok"]]
+    if bad:
+        note += f"; at {bad[0]['freq_hz']:.6g} Hz {bad[0]['message']}"
+    if record["skipped"]:
+        note += f"; {len(record['skipped'])} not simulated (budget {record['budget']:g} s)"
+    near = [e for s in record["stretches"] for e in s["neighbour_errors"]]
+    if near:
+        f, e = max(near, key=lambda t: t[1])
+        H = max(harmonics) if len(harmonics) else "?"
+        note += (f". The traced point at {f:.6g} Hz next to it is estimated {100 * e:.0f} % off: the response "
+                 f"there needs far more than H = {H} harmonics (a contact that sticks for most of the period "
+                 f"rings in the truncated series by more than its stick range), so the continuation could not go on")
+    return note
