@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 import hbm
-from hbm.analyses.time_fill import MIN_WIDTH, fill_frequencies, fill_untraced, spread_order, untraced_stretches
+from hbm.analyses.time_fill import (MIN_WIDTH, check_points, fill_frequencies, fill_untraced, spread_order,
+                                    untraced_stretches, wanted)
 from hbm.interface.case import case_from_dict
 from hbm.interface.report import write_frf
 
@@ -57,7 +58,7 @@ def _stiff_oscillator():
         "model": {"mass": [[1.0]], "stiffness": [[1.0]], "damping": [[0.0]]},
         "element": [{"type": "jenkins", "dofs": [0], "kt": 1e5, "slip_force": 0.9}],
         "excitation": {"dofs": [0], "amplitude": [1.0]},
-        "analysis": {"harmonics": 15, "frequency_hz": [0.0795775, 0.2], "outputs": {"x": 0}},
+        "analysis": {"harmonics": 15, "frequency_hz": [0.086, 0.2], "outputs": {"x": 0}},
     })
 
 
@@ -66,24 +67,33 @@ def test_a_stop_short_of_the_window_is_answered_by_time_simulations(tmp_path):
     res = hbm.frf(case, stability=False)
     assert res.status == "failed"                    # the window's start is not reached (module doc)
     (a, b), = untraced_stretches(res)
-    assert a == pytest.approx(0.0795775) and 0.09 < b < 0.11
-    rec = fill_untraced(case, res, budget=12.0, max_points=3)
-    assert res.settings["time_fill"] is rec
-    freqs = [p["freq_hz"] for p in rec["points"]] + rec["skipped"]
-    assert sorted(freqs)[0] == pytest.approx(a) and all(a <= f < b for f in freqs)
-    ok = [p for p in rec["points"] if p["ok"]]
-    assert ok, rec["note"]
-    p = ok[0]                                        # the same answer as hbm timesim there
-    ref = hbm.timesim(case, p["freq_hz"])
-    assert p["h1"]["x"] == pytest.approx(ref.h1["x"], rel=1e-9) and p["error_estimate"] < 1e-2
-    assert p["h1"]["x"] > 0.8                        # the HBM point next to the stop has 0.64-0.74
+    assert a == 0.086 and 0.09 < b < 0.11
+    # 3 points: 2 in the stretch (0.086 Hz settles in 39 periods), 1 check of the traced point
+    # next to the stop (estimated 62 % off; settles in 77 periods)
+    rec = fill_untraced(case, res, budget=20.0, max_points=3)
+    assert res.settings["time_fill"] is rec and rec["skipped"] == []
+    untraced = [p for p in rec["points"] if p["kind"] == "untraced"]
+    check, = [p for p in rec["points"] if p["kind"] == "check"]
+    assert [p["freq_hz"] for p in untraced] == pytest.approx([a, (a + b) / 2])
+    first = untraced[0]
+    assert first["ok"] and first["error_estimate"] < 1e-3
+    assert first["h1"]["x"] == pytest.approx(hbm.timesim(case, a).h1["x"], rel=1e-12)
+    assert first["h1"]["x"] > 0.85                   # the HBM point next to the stop has 0.80
+    # the check: the HBM's point against the time domain at its frequency
+    i = int(np.argmin(np.abs(res.freq_hz - b)))
+    assert check["freq_hz"] == pytest.approx(b) and check["hbm_estimate"] > 0.3
+    assert check["hbm_h1"]["x"] == res.outputs["x"].h1[i]
+    assert check["ok"] and check["hbm_off"] == pytest.approx(abs(res.outputs["x"].h1[i] / check["h1"]["x"] - 1))
+    assert 0.05 < check["hbm_off"] < check["hbm_estimate"]     # off indeed, within its estimate
     (f_near, e_near), = rec["stretches"][0]["neighbour_errors"]
     assert f_near == pytest.approx(b) and e_near > 0.3
-    assert "estimated" in rec["note"] and "H = 15" in rec["note"]
+    assert "estimated" in rec["note"] and "H = 15" in rec["note"] and "1 traced point estimated" in rec["note"]
     write_frf(case, res, tmp_path)
     rows = list(csv.DictReader(open(tmp_path / "frf_timedomain.csv")))
     assert [float(r["freq_hz"]) for r in rows] == pytest.approx([q["freq_hz"] for q in rec["points"]])
     assert all((r["x_h1"] != "") == bool(int(r["periodic"])) for r in rows)
+    assert [r["kind"] for r in rows] == [q["kind"] for q in rec["points"]]
+    assert float(rows[-1]["x_hbm_h1"]) == pytest.approx(check["hbm_h1"]["x"])
     assert (tmp_path / "frf.png").stat().st_size > 0
 
 
@@ -95,6 +105,17 @@ def test_no_budget_simulates_nothing_and_says_so():
     assert "0 of 4" in rec["note"] and "4 not simulated (budget 0 s)" in rec["note"]
 
 
+def test_only_points_estimated_far_off_are_checked():
+    res = SimpleNamespace(freq_hz=np.array([1.0, 2.0, 3.0, 4.0, 5.0]), status="finished", settings={},
+                          outputs={"x": SimpleNamespace(err=np.array([0.01, 0.5, np.nan, 0.3, 0.25])),
+                                   "y": SimpleNamespace(err=np.array([0.3, 0.0, 0.0, 0.0, 0.0]))})
+    assert check_points(res, 10) == [0, 1, 3, 4]
+    assert check_points(res, 2) == [0, 4]            # spread over their frequencies
+    assert wanted(res)
+    res.outputs = {"x": SimpleNamespace(err=np.full(5, 0.1))}
+    assert not wanted(res) and check_points(res, 3) == []
+
+
 def test_hbm_frf_writes_the_time_domain_points_and_says_where(tmp_path):
     import subprocess
     import sys
@@ -102,13 +123,13 @@ def test_hbm_frf_writes_the_time_domain_points_and_says_where(tmp_path):
     toml.write_text('name = "stiff"\n[model]\nmass = [[1.0]]\nstiffness = [[1.0]]\ndamping = [[0.0]]\n'
                     '[[element]]\ntype = "jenkins"\ndofs = [0]\nkt = 1e5\nslip_force = 0.9\n'
                     '[excitation]\ndofs = [0]\namplitude = [1.0]\n'
-                    '[analysis]\nharmonics = 15\nfrequency_hz = [0.0795775, 0.2]\noutputs = { x = 0 }\n')
+                    '[analysis]\nharmonics = 15\nfrequency_hz = [0.086, 0.2]\noutputs = { x = 0 }\n')
     run = lambda out, *extra: subprocess.run(   # noqa: E731
         [sys.executable, "-m", "hbm", "frf", str(toml), "-o", str(tmp_path / out), "--harmonics", "15",
          "--no-stability", "-q", *extra], capture_output=True, text=True)
     r = run("fill", "--time-fill", "3")
     assert r.returncode == 1, r.stderr              # the HBM run still stopped: said, not hidden
-    assert "untraced 0.0795775..0.10146" in r.stdout and "frf_timedomain.csv" in r.stdout
+    assert "untraced 0.086..0.0978965 Hz" in r.stdout and "frf_timedomain.csv" in r.stdout
     assert (tmp_path / "fill" / "frf_timedomain.csv").exists()
     r = run("none", "--time-fill", "0")
     assert r.returncode == 1 and not (tmp_path / "none" / "frf_timedomain.csv").exists()

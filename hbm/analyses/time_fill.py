@@ -1,4 +1,4 @@
-r"""Time-domain answers where the harmonic balance left the window untraced.
+r"""Time-domain answers where the harmonic balance left the window untraced or is far off.
 
 When the continuation stops short or restarts past a gap, the stretches of
 :math:`[f_{min}, f_{max}]` that no traced segment covers have no HBM answer.  Where the
@@ -10,6 +10,10 @@ steady-state time simulation (:func:`hbm.timedomain.timesim.timesim`, Newmark wi
 switches and an ``n`` / ``2 n`` error estimate) at points spread over the untraced stretches,
 within a time budget.  The points are kept apart from the HBM path (``settings["time_fill"]``,
 ``frf_timedomain.csv``, markers in ``frf.png``): they carry no harmonic coefficients.
+
+The same simulations check the traced points estimated more than ``UNRELIABLE`` off (up to a
+third of the points when there are some): each such point's record holds the HBM's first
+harmonics beside the time domain's, and how far apart they are.
 
 A stretch is ``[a, b]`` with ``a`` and ``b`` the ends of the traced spans around it (or the
 window's ends); its points sit at the window's end when the stretch reaches it, else at
@@ -27,6 +31,7 @@ BUDGET_SECONDS = 30.0   # time simulations stop being started after this
 MAX_POINTS = 12         # points over all stretches
 POINT_SHARE = 0.25      # a point that has not settled after this share of the budget is abandoned
 LARGE_ERROR = 0.1       # a traced point next to a stretch estimated this far off is named
+UNRELIABLE = 0.2        # traced points estimated this far off are checked in the time domain
 
 
 def untraced_stretches(res) -> list:
@@ -94,10 +99,9 @@ def fill_frequencies(stretches: list, window: tuple, max_points: int = MAX_POINT
 def _neighbour_errors(res, a: float, b: float) -> list:
     """Largest estimated first-harmonic error (over the outputs) of the traced points nearest
     to ``a`` and ``b``, for those above ``LARGE_ERROR``: ``[(freq_hz, error), ...]``."""
-    errs = [o.err for o in res.outputs.values() if o.err is not None]
-    if not errs or res.freq_hz.size == 0:
+    worst = _worst_errors(res)
+    if worst is None:
         return []
-    worst = np.nanmax(np.array(errs), axis=0)
     out = []
     for f in {a, b}:
         i = int(np.argmin(np.abs(res.freq_hz - f)))
@@ -137,10 +141,47 @@ def spread_order(n: int) -> list:
     return sorted(range(n), key=lambda i: keys[i])
 
 
+def _worst_errors(res):
+    """Largest estimated first-harmonic error over the outputs, per point (n_points,), or None."""
+    errs = [o.err for o in res.outputs.values() if o.err is not None]
+    return np.nan_to_num(np.array(errs), nan=0.0).max(axis=0) if errs and res.freq_hz.size else None
+
+
+def check_points(res, k: int) -> list:
+    """Up to ``k`` path indices of points estimated more than ``UNRELIABLE`` off, spread over
+    their frequencies."""
+    worst = _worst_errors(res)
+    if worst is None or k <= 0:
+        return []
+    idx = np.flatnonzero(worst > UNRELIABLE)
+    idx = idx[np.argsort(res.freq_hz[idx], kind="stable")]
+    if idx.size > k:
+        idx = idx[np.unique(np.round(np.linspace(0, idx.size - 1, k)).astype(int))]
+    return [int(i) for i in idx]
+
+
+def wanted(res) -> bool:
+    """Whether :func:`fill_untraced` has anything to do: a stop, a gap, or a point estimated
+    more than ``UNRELIABLE`` off."""
+    worst = _worst_errors(res)
+    return (res.status != "finished" or bool(res.settings.get("gaps"))
+            or (worst is not None and bool(np.nanmax(worst) > UNRELIABLE)))
+
+
+def _compare(p: dict, res, i: int) -> dict:
+    """A time-domain point at path point ``i``, with the HBM's first harmonics beside it."""
+    hbm = {n: float(o.h1[i]) for n, o in res.outputs.items()}
+    p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(_worst_errors(res)[i])}
+    if p["ok"]:
+        p["hbm_off"] = max(abs(hbm[n] / p["h1"][n] - 1.0) for n in hbm if p["h1"][n] != 0.0)
+    return p
+
+
 def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = MAX_POINTS,
                   progress=None) -> dict | None:
-    """Time-simulate the stretches of the window that ``res`` left untraced (module doc) and
-    record them in ``res.settings["time_fill"]``.
+    """Time-simulate the stretches of the window that ``res`` left untraced, and the traced
+    points estimated more than ``UNRELIABLE`` off (module doc); record them in
+    ``res.settings["time_fill"]``.
 
     Parameters
     ----------
@@ -149,6 +190,7 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     budget : float
         No simulation is started once this many seconds have been spent.
     max_points : int
+        Simulations in all; a third of them go to the far-off points when there are some.
     progress : callable, optional
         ``progress(done, total)`` after each simulation.
 
@@ -156,30 +198,35 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     -------
     dict or None
         ``stretches`` (each ``a_hz``, ``b_hz``, ``neighbour_errors``), ``points`` (each
-        ``freq_hz``, ``ok``, per output ``h1`` and ``max``, ``error_estimate``, ``periods``,
-        ``seconds``, ``message``), ``skipped`` (frequencies not simulated for the budget),
-        ``seconds``, ``note``; None when the run left nothing wide enough untraced or its
-        model is not simulated here (the condensed solver's models: their time integration
-        runs on every DOF).
+        ``freq_hz``, ``kind`` (``untraced`` / ``check``), ``ok``, per output ``h1`` and ``max``,
+        ``error_estimate``, ``periods``, ``seconds``, ``message``; a check also ``hbm_h1``,
+        ``hbm_estimate`` and ``hbm_off``, the HBM's largest relative deviation), ``skipped``
+        (frequencies not simulated for the budget), ``seconds``, ``note``; None when there is
+        nothing to simulate or the model is not simulated here (the condensed solver's models:
+        their time integration runs on every DOF).
     """
     from hbm.analyses.problem_setup import choose_solver
     if res.freq_hz.size == 0 or choose_solver(case) != "full":
         return None
     window = (float(res.settings["fmin_hz"]), float(res.settings["fmax_hz"]))
     stretches = untraced_stretches(res)
-    freqs = fill_frequencies(stretches, window, max_points)
-    todo = [f for fs in freqs for f in fs]
+    n_checks = max_points // 3 if check_points(res, 1) else 0
+    freqs = fill_frequencies(stretches, window, max_points - n_checks)
+    todo = [(f, None) for fs in freqs for f in fs]
+    todo += [(float(res.freq_hz[i]), i) for i in check_points(res, max_points - len(todo))]
     if not todo:
         return None
     t0, points, skipped = time.perf_counter(), [], []
-    for i in spread_order(len(todo)):
+    for k in spread_order(len(todo)):
+        f, i = todo[k]
         left = budget - (time.perf_counter() - t0)
         if left <= 0:
-            skipped.append(todo[i])
+            skipped.append(f)
             continue
         share = POINT_SHARE * budget
         why = "a point's share of the budget" if share < left else "the budget ran out"
-        points.append(_simulate(case, todo[i], min(left, share), why))
+        p = {"kind": "untraced", **_simulate(case, f, min(left, share), why)}
+        points.append(p if i is None else _compare(p, res, i))
         if progress is not None:
             progress(len(points), len(todo))
     points.sort(key=lambda p: p["freq_hz"])
@@ -193,13 +240,21 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
 
 
 def fill_note(record: dict, harmonics) -> str:
-    """One line: what was simulated where, what the traced points next to it say, what failed."""
+    """One line: what was simulated where, what the traced points next to it say, what the
+    checks of far-off points found, what failed."""
     ok = [p for p in record["points"] if p["ok"]]
     parts = [f"{a['a_hz']:.6g}..{a['b_hz']:.6g} Hz" for a in record["stretches"]]
-    note = (f"untraced {', '.join(parts)}: {len(ok)} of {len(record['points']) + len(record['skipped'])} "
+    checks = [p for p in record["points"] if p["kind"] == "check"]
+    where = [f"untraced {', '.join(parts)}"] if parts else []
+    where += [f"{len(checks)} traced point{'s' * (len(checks) > 1)} estimated over {100 * UNRELIABLE:.0f} % "
+              f"off"] if checks else []
+    note = (f"{' and '.join(where)}: {len(ok)} of {len(record['points']) + len(record['skipped'])} "
             f"time-domain points (hbm timesim, {record['seconds']:.1f} s) in frf_timedomain.csv")
     if ok:
         note += f", estimated error up to {max(p['error_estimate'] for p in ok):.1e}"
+    off = [p["hbm_off"] for p in checks if p["ok"]]
+    if off:
+        note += f"; there the HBM's first harmonic is off by {100 * min(off):.2g}-{100 * max(off):.2g} %"
     bad = [p for p in record["points"] if not p["ok"]]
     if bad:
         note += f"; at {bad[0]['freq_hz']:.6g} Hz {bad[0]['message']}"

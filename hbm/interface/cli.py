@@ -80,8 +80,8 @@ def build_parser():
                         "error of the first harmonic is below TOL (column H: each point's harmonics; default "
                         "1e-2 unless --harmonics is given)")
     f.add_argument("--time-fill", type=lambda t: _positive_float(t, zero=True), default=30.0, metavar="SECONDS",
-                   help="where the continuation leaves the window untraced, run time simulations there for at "
-                        "most SECONDS (frf_timedomain.csv; default 30, 0: none)")
+                   help="where the continuation leaves the window untraced, or a point is estimated over 20 %% off, "
+                        "run time simulations there for at most SECONDS (frf_timedomain.csv; default 30, 0: none)")
     _add_analysis_options(f)
     t = sub.add_parser("timesim", help="time-domain reference at one frequency (steady state or transient)")
     t.add_argument("case", help="case file (TOML)")
@@ -133,13 +133,13 @@ def _check_outdir(path):
 
 
 def _time_fill(case, res, args) -> bool:
-    """Time-simulate what the run left untraced (``--time-fill`` seconds; the HBM files are
-    already on disk); True when points were added to ``res.settings``."""
-    from hbm.analyses.time_fill import fill_untraced
+    """Time-simulate what the run left untraced or estimates far off (``--time-fill`` seconds;
+    the HBM files are already on disk); True when points were added to ``res.settings``."""
+    from hbm.analyses.time_fill import fill_untraced, wanted
     from hbm.interface.progress import CountProgress
-    if args.time_fill <= 0 or (res.status == "finished" and not res.settings.get("gaps")):
+    if args.time_fill <= 0 or not wanted(res):
         return False
-    bar = None if args.quiet else CountProgress(1, "point", "time domain (untraced stretches)")
+    bar = None if args.quiet else CountProgress(1, "point", "time domain")
 
     def progress(done, total):
         if bar is not None:

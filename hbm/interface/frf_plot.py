@@ -8,7 +8,8 @@ method finds unstable are drawn dotted and grey-backed; the jumps of slow sweeps
 (up-sweep red, down-sweep blue; a jump with no stable landing ends in a cross); a shaded
 band is the estimated truncation error of the first harmonic (:mod:`hbm.analyses.truncation`); folds are
 faint vertical lines; diamonds are time-domain points where the continuation left the window
-untraced (:mod:`hbm.analyses.time_fill`; filled: first harmonic, open: max).  A panel below draws that estimated error on a log scale with 1 %
+untraced or a point is estimated far off (:mod:`hbm.analyses.time_fill`; filled: first
+harmonic, open: max).  A panel below draws that estimated error on a log scale with 1 %
 marked; a lower panel, when the case asks for element outputs
 (``"ELEMENT.QUANTITY"``, e.g. a contact's slip fraction or normal load), draws them against
 the same frequency axis.
@@ -67,7 +68,7 @@ def _draw_jumps(ax, jumps, scale):
 
 
 def _draw_fill(ax, points, names, colours, scale):
-    """Time-domain points of an untraced stretch (:mod:`hbm.analyses.time_fill`): per output the
+    """Time-domain points (:mod:`hbm.analyses.time_fill`: untraced stretches, far-off points): per output the
     first harmonic (filled diamonds) and max (open diamonds), at the points that settled."""
     ok = [p for p in points if p["ok"]]
     if not ok:
@@ -77,7 +78,7 @@ def _draw_fill(ax, points, names, colours, scale):
         c = colours[k % len(colours)]
         ax.plot(f, [p["h1"][name] / scale for p in ok], "D", ms=4, color=c)
         ax.plot(f, [p["max"][name] / scale for p in ok], "D", ms=4, mfc="none", color=c)
-    ax.plot([], [], "D", ms=4, color="0.3", label="time domain (untraced by HBM)")
+    ax.plot([], [], "D", ms=4, color="0.3", label="time domain (untraced, or HBM far off)")
 
 
 def _draw_errors(ax, freq, errs, colours, tol=None):

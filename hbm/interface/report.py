@@ -116,14 +116,19 @@ def write_csv(res, path: Path) -> None:
 
 def format_fill_csv(record: dict, names) -> str:
     """The ``frf_timedomain.csv`` text of a time fill (:func:`hbm.analyses.time_fill.fill_untraced`):
-    one row per simulated frequency, amplitudes empty where the simulation did not settle."""
+    one row per simulated frequency, amplitudes empty where the simulation did not settle;
+    ``kind`` says whether it answers an untraced stretch or checks a traced point (whose
+    first harmonics are then beside it as ``NAME_hbm_h1``)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["freq_hz"] + [f"{n}_{k}" for n in names for k in ("h1", "max")]
+    w.writerow(["freq_hz", "kind"] + [f"{n}_{k}" for n in names for k in ("h1", "max", "hbm_h1")]
                + ["error_estimate", "periods", "seconds", "periodic", "message"])
     for p in record["points"]:
-        amps = [f"{p[k][n]:.10g}" if p["ok"] else "" for n in names for k in ("h1", "max")]
-        w.writerow([f"{p['freq_hz']:.10g}"] + amps
+        amps = []
+        for n in names:
+            amps += [f"{p[k][n]:.10g}" if p["ok"] else "" for k in ("h1", "max")]
+            amps.append(f"{p['hbm_h1'][n]:.10g}" if "hbm_h1" in p else "")
+        w.writerow([f"{p['freq_hz']:.10g}", p["kind"]] + amps
                    + [f"{p['error_estimate']:.3g}" if p["ok"] else "", p.get("periods", ""),
                       f"{p['seconds']:.3g}", int(p["ok"]), p["message"]])
     return buf.getvalue()
