@@ -1,7 +1,9 @@
 """The stiff and separating contacts of the issue on stopping short, run as a new user would.
 
 Each case runs ``hbm.frf`` with its defaults (stability off, as the issue ran them) and once
-more with ``aft = "events"`` (exact switches, no sampling).  Printed and
+more with ``aft = "events"`` (exact switches, no sampling); where a run stops, leaves gaps or
+has points estimated over 20 % off, the time fill of ``hbm frf`` (30 s) runs on it, and the
+points that settled and how far off the checked HBM points are go to the table.  Printed and
 written to benchmarks/results/stiff_contacts.csv: status, points, largest energy-balance
 error, CPU seconds, and for the Jenkins SDOF with viscous damping the largest error against
 den Hartog's closed form (viscous + Coulomb, continuous motion) over the window.
@@ -24,6 +26,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import hbm                                      # noqa: E402
 from den_hartog import den_hartog               # noqa: E402
+from hbm.analyses.time_fill import fill_untraced, wanted  # noqa: E402
 from hbm.interface.case import case_from_dict   # noqa: E402
 from time_vs_error import write_rows            # noqa: E402
 
@@ -79,6 +82,16 @@ def den_hartog_error(res, c):
     return max(errs) if errs else float("nan")
 
 
+def time_fill(case, res) -> dict:
+    """What ``hbm frf``'s time fill (30 s) finds where the run stopped, left gaps or is far off."""
+    rec = fill_untraced(case, res) if wanted(res) else None
+    if rec is None:
+        return {"fill_settled": "", "fill_points": 0, "fill_hbm_off": ""}
+    off = [p["hbm_off"] for p in rec["points"] if p["kind"] == "check" and p["ok"]]
+    return {"fill_settled": sum(p["ok"] for p in rec["points"]), "fill_points": len(rec["points"]),
+            "fill_hbm_off": f"{min(off):.2g}-{max(off):.2g}" if off else ""}
+
+
 def cases():
     for aft in ("sampled", "events"):
         for kt, H in ((1e4, 7), (1e5, 15), (1e6, 25)):
@@ -102,9 +115,11 @@ def main():
                    energy_max=float(np.max(res.energy_error)) if res.freq_hz.size else float("nan"),
                    cpu_s=round(dt, 2), den_hartog_max_err=err, message=res.message)
         row["gaps"] = res.settings.get("gap_warning", "")
+        row.update(time_fill(case, res))
         rows.append(row)
         print(f"{name:42s} {res.status:9s} {row['points']:5d} pts  energy {row['energy_max']:.1e}  "
-              f"{dt:6.2f} s  den Hartog {err:.2e}  {res.message[:90]}", flush=True)
+              f"{dt:6.2f} s  den Hartog {err:.2e}  time fill {row['fill_settled']}/{row['fill_points']} "
+              f"(HBM off {row['fill_hbm_off'] or '-'})  {res.message[:90]}", flush=True)
     write_rows(ROOT / "benchmarks" / "results" / "stiff_contacts.csv", rows)
 
 

@@ -63,6 +63,8 @@ def main() -> None:
                 page += [f"Warning: {st[key]}", ""]
         if s["status"] != "finished":
             page += [f"**`hbm frf` stops on this rig with its defaults:** {s['message']}", ""]
+        if st.get("time_fill"):
+            page += [f"Time domain (diamonds in the figure): {st['time_fill']['note']}.", ""]
         if doc.exists():
             page += [f"The rig's document, with the paper's numbers beside ours: `rigs/{doc.name}`.", ""]
         (DOCS / "gallery" / f"{case.stem}.md").write_text("\n".join(page))

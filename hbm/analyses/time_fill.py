@@ -28,7 +28,7 @@ import numpy as np
 
 MIN_WIDTH = 1e-4        # stretches narrower than this share of the window get no point
 BUDGET_SECONDS = 30.0   # time simulations stop being started after this
-MAX_POINTS = 12         # points over all stretches
+MAX_POINTS = 12         # simulations in all (stretches and checks)
 POINT_SHARE = 0.25      # a point that has not settled after this share of the budget is abandoned
 LARGE_ERROR = 0.1       # a traced point next to a stretch estimated this far off is named
 UNRELIABLE = 0.2        # traced points estimated this far off are checked in the time domain

@@ -68,8 +68,8 @@ def _draw_jumps(ax, jumps, scale):
 
 
 def _draw_fill(ax, points, names, colours, scale):
-    """Time-domain points (:mod:`hbm.analyses.time_fill`: untraced stretches, far-off points): per output the
-    first harmonic (filled diamonds) and max (open diamonds), at the points that settled."""
+    """Time-domain points (:mod:`hbm.analyses.time_fill`: untraced stretches, far-off points):
+    per output the first harmonic (filled diamonds) and max (open diamonds), where they settled."""
     ok = [p for p in points if p["ok"]]
     if not ok:
         return
