@@ -265,6 +265,7 @@ def fill_note(record: dict, harmonics) -> str:
         f, e = max(near, key=lambda t: t[1])
         H = max(harmonics) if len(harmonics) else "?"
         note += (f". The traced point at {f:.6g} Hz next to it is estimated {100 * e:.0f} % off: the response "
-                 f"there needs far more than H = {H} harmonics (a contact that sticks for most of the period "
-                 f"rings in the truncated series by more than its stick range), so the continuation could not go on")
+                 f"there is beyond H = {H} harmonics, and the continuation stalls where it cannot be represented "
+                 f"(e.g. a stiff contact that sticks for most of the period: its truncated motion rings by more "
+                 f"than its stick range)")
     return note
