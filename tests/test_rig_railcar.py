@@ -82,3 +82,14 @@ def test_relative_motion_rises_from_30_to_40_hz(runs):
     assert r[40.0]["pkpk_x"] > 4.0 * r[30.0]["pkpk_x"], (r[30.0]["pkpk_x"], r[40.0]["pkpk_x"])
     # and the pure-slip response at 40 Hz is of the order of the track input (A = 0.2 mm)
     assert 0.5 * 2e-4 < r[40.0]["pkpk_x"] < 4 * 2e-4
+
+
+def test_harmonic_content_against_table_3(runs):
+    # rigs/studies/railcar_table3.py: the strongest higher harmonic of the relative displacement
+    # at 30 Hz is the 3rd, as in the paper's Table 3 (AR 8.7; ours 5.4: more distorted); at
+    # 40 Hz the 2nd and 3rd lead, as in the paper (which has the 2nd four times stronger)
+    from rigs.studies.railcar_table3 import PAPER, peaks
+    case, r = runs
+    (ar30, h30), *_ = peaks(r[30.0]["x"])
+    assert h30 == PAPER[30.0][0][1] == 3 and ar30 == pytest.approx(5.42, rel=0.05)
+    assert {h for _, h in peaks(r[40.0]["x"])[:2]} == {h for _, h in PAPER[40.0][:2]} == {2, 3}
