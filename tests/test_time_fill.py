@@ -134,3 +134,15 @@ def test_hbm_frf_writes_the_time_domain_points_and_says_where(tmp_path):
     r = run("none", "--time-fill", "0")
     assert r.returncode == 1 and not (tmp_path / "none" / "frf_timedomain.csv").exists()
     assert "time-domain points" not in r.stdout
+
+
+def test_a_refused_or_failed_integration_is_recorded_not_raised(monkeypatch):
+    import hbm.timedomain.timesim as ts
+    from hbm.analyses import time_fill
+    from hbm.interface.case import CaseError
+
+    def refuse(case, f, progress=None):
+        raise CaseError("the time history needs 40 GB") if f < 1 else RuntimeError("Newton did not converge")
+    monkeypatch.setattr(ts, "timesim", refuse)
+    p, q = time_fill._simulate(None, 0.5, 1.0, "x"), time_fill._simulate(None, 2.0, 1.0, "x")
+    assert not p["ok"] and "40 GB" in p["message"] and not q["ok"] and "Newton" in q["message"]

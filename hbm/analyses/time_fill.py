@@ -117,6 +117,7 @@ class _OutOfTime(Exception):
 def _simulate(case, f: float, seconds: float, why: str) -> dict:
     """One steady-state time simulation at ``f`` Hz as a JSON-friendly record, abandoned
     (``ok`` False) after about ``seconds`` (``why``: what limited them)."""
+    from hbm.interface.case import CaseError
     from hbm.timedomain.timesim import timesim
     t0 = time.perf_counter()
 
@@ -125,7 +126,7 @@ def _simulate(case, f: float, seconds: float, why: str) -> dict:
             raise _OutOfTime(f"not periodic after {periods} periods in {seconds:.1f} s ({why})")
     try:
         r = timesim(case, f, progress=watch)
-    except (RuntimeError, _OutOfTime) as exc:
+    except (RuntimeError, CaseError, _OutOfTime) as exc:      # a failed or refused integration
         return {"freq_hz": f, "ok": False, "message": str(exc), "seconds": time.perf_counter() - t0}
     return {"freq_hz": f, "ok": bool(r.converged), "h1": dict(r.h1), "max": dict(r.max),
             "error_estimate": float(r.error_estimate), "periods": int(r.periods),
