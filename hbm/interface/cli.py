@@ -143,7 +143,7 @@ def _time_fill(case, res, args) -> bool:
 
     def progress(done, total):
         if bar is not None:
-            bar.bar.total = total
+            bar.resize(total)
             bar(done)
     try:
         return fill_untraced(case, res, budget=args.time_fill, progress=progress) is not None

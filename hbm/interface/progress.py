@@ -74,6 +74,11 @@ class CountProgress:
     def __init__(self, total: int, unit: str, desc: str):
         self.bar = _bar(total, unit, desc)
 
+    def resize(self, total: int) -> None:
+        """Set the count once it is known (e.g. the time fill's simulations)."""
+        self.bar.total = total
+        self.bar.refresh()
+
     def __call__(self, done: int, note: str = "") -> None:
         if done > self.bar.n:
             self.bar.update(min(done, self.bar.total) - self.bar.n)
