@@ -131,8 +131,8 @@ def test_hbm_frf_writes_the_time_domain_points_and_says_where(tmp_path):
     assert r.returncode == 1, r.stderr              # the HBM run still stopped: said, not hidden
     assert "untraced 0.086..0.0978965 Hz" in r.stdout and "frf_timedomain.csv" in r.stdout
     assert (tmp_path / "fill" / "frf_timedomain.csv").exists()
-    r = run("none", "--time-fill", "0")
-    assert r.returncode == 1 and not (tmp_path / "none" / "frf_timedomain.csv").exists()
+    r = run("fill", "--time-fill", "0")                 # the same folder again: no stale points
+    assert r.returncode == 1 and not (tmp_path / "fill" / "frf_timedomain.csv").exists()
     assert "time-domain points" not in r.stdout
 
 

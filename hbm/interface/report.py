@@ -186,6 +186,8 @@ def write_frf(case, res, outdir, extra=None) -> dict:
     fill = res.settings.get("time_fill")
     if fill:
         (out / "frf_timedomain.csv").write_text(format_fill_csv(fill, list(res.outputs)))
+    else:
+        (out / "frf_timedomain.csv").unlink(missing_ok=True)        # a previous run's
     summary = summary_dict(case, res, extra)
     with open(out / "summary.json", "w") as fh:
         json.dump(summary, fh, indent=2)
