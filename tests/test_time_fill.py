@@ -62,9 +62,14 @@ def _stiff_oscillator():
     })
 
 
-def test_a_stop_short_of_the_window_is_answered_by_time_simulations(tmp_path):
+@pytest.fixture(scope="module")
+def stopped():
     case = _stiff_oscillator()
-    res = hbm.frf(case, stability=False)
+    return case, hbm.frf(case, stability=False)
+
+
+def test_a_stop_short_of_the_window_is_answered_by_time_simulations(stopped, tmp_path):
+    case, res = stopped
     assert res.status == "failed"                    # the window's start is not reached (module doc)
     (a, b), = untraced_stretches(res)
     assert a == 0.086 and 0.09 < b < 0.11
@@ -95,11 +100,15 @@ def test_a_stop_short_of_the_window_is_answered_by_time_simulations(tmp_path):
     assert [r["kind"] for r in rows] == [q["kind"] for q in rec["points"]]
     assert float(rows[-1]["x_hbm_h1"]) == pytest.approx(check["hbm_h1"]["x"])
     assert (tmp_path / "frf.png").stat().st_size > 0
+    del res.settings["time_fill"]                    # the same folder again: no stale points
+    write_frf(case, res, tmp_path)
+    assert not (tmp_path / "frf_timedomain.csv").exists()
 
 
-def test_no_budget_simulates_nothing_and_says_so():
-    case = _stiff_oscillator()
-    res = hbm.frf(case, stability=False, error_estimate=False)
+def test_no_budget_simulates_nothing_and_says_so(stopped):
+    from hbm.interface.cli import _time_fill
+    case, res = stopped
+    assert not _time_fill(case, res, SimpleNamespace(time_fill=0.0, quiet=True))     # --time-fill 0
     rec = fill_untraced(case, res, budget=0.0, max_points=4)
     assert rec["points"] == [] and len(rec["skipped"]) == 4
     assert "0 of 4" in rec["note"] and "4 not simulated (budget 0 s)" in rec["note"]
@@ -131,9 +140,6 @@ def test_hbm_frf_writes_the_time_domain_points_and_says_where(tmp_path):
     assert r.returncode == 1, r.stderr              # the HBM run still stopped: said, not hidden
     assert "untraced 0.086..0.0978965 Hz" in r.stdout and "frf_timedomain.csv" in r.stdout
     assert (tmp_path / "fill" / "frf_timedomain.csv").exists()
-    r = run("fill", "--time-fill", "0")                 # the same folder again: no stale points
-    assert r.returncode == 1 and not (tmp_path / "fill" / "frf_timedomain.csv").exists()
-    assert "time-domain points" not in r.stdout
 
 
 def test_a_refused_or_failed_integration_is_recorded_not_raised(monkeypatch):
