@@ -99,3 +99,11 @@ def test_a_gap_states_how_much_the_response_changes_across_it():
     a, b = (int(np.flatnonzero(res.freq_hz == g[k])[0]) for k in ("from_hz", "to_hz"))
     h1 = max(abs(o.h1[a] - o.h1[b]) / max(o.h1[a], o.h1[b]) for o in res.outputs.values())
     assert abs(h1 - g["h1_change"]) < 1e-9
+
+
+def test_a_gap_of_no_visible_width_is_named_a_corner():
+    from hbm.analyses.trace import _gap_text
+    corner = _gap_text({"from_hz": 15.8365, "to_hz": 15.8365 * (1 + 3e-8), "h1_change": 6e-6, "change": 6e-3})
+    assert "15.8365 Hz (a corner of the path, 3e-08 of the frequency wide)" in corner and "6.0e-06" in corner
+    gap = _gap_text({"from_hz": 0.2087, "to_hz": 0.2221, "h1_change": 1.0, "change": 1.5})
+    assert gap.startswith("0.2087..0.2221 Hz (outputs across it") and "corner" not in gap

@@ -162,6 +162,7 @@ GAP_FIRST = 1e-3        # first restart this share of the window past a stop, do
 GAP_TRIES = 8
 TD_TRIES, TD_EVERY = 2, 3      # time-domain starts past a stop: at 1 and 8 times GAP_FIRST
 MAX_GAPS = 10
+CORNER = 1e-6           # a gap narrower than this share of its frequency is named a corner
 
 
 def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, opts, progress, lam_step,
@@ -209,11 +210,19 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
         segments.append([start, len(pts.w)])
     if gaps:
         settings["gaps"] = gaps
-        where = ", ".join(f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz (outputs across it: first harmonics "
-                          f"{g['h1_change']:.1e}, whole response {g['change']:.1e})" for g in gaps)
+        where = ", ".join(_gap_text(g) for g in gaps)
         settings["gap_warning"] = (f"the continuation stopped {len(gaps)} time(s) and was restarted further on; "
                                    f"not traced: {where} (first stop: {gaps[0]['reason']})")
     return status, message, folds, n_rej
+
+
+def _gap_text(g: dict) -> str:
+    """One gap for the warning; a gap narrower than ``CORNER`` of its frequency is called a
+    corner of the path (e.g. a stuck slider's offset that jumps when it starts to slip)."""
+    width = (g["to_hz"] - g["from_hz"]) / g["from_hz"]
+    where = (f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz" if width >= CORNER else
+             f"{g['from_hz']:.8g} Hz (a corner of the path, {width:.0e} of the frequency wide)")
+    return f"{where} (outputs across it: first harmonics {g['h1_change']:.1e}, whole response {g['change']:.1e})"
 
 
 def _jump(basis, Ya: np.ndarray, Yb: np.ndarray) -> dict:
