@@ -160,6 +160,8 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
         ex.grid(True, alpha=0.3)
         ex.legend(fontsize=7)
     axes[-1, 0].set_xlabel("frequency (Hz)")
+    if "fmin_hz" in res.settings and "fmax_hz" in res.settings:      # the whole window, traced or not
+        axes[-1, 0].set_xlim(res.settings["fmin_hz"], res.settings["fmax_hz"])
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
