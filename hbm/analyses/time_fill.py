@@ -174,7 +174,8 @@ def _compare(p: dict, res, i: int) -> dict:
     hbm = {n: float(o.h1[i]) for n, o in res.outputs.items()}
     p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(_worst_errors(res)[i])}
     if p["ok"]:
-        p["hbm_off"] = max(abs(hbm[n] / p["h1"][n] - 1.0) for n in hbm if p["h1"][n] != 0.0)
+        p["hbm_off"] = max((abs(hbm[n] / p["h1"][n] - 1.0) for n in hbm if p["h1"][n] != 0.0),
+                           default=float("nan"))
     return p
 
 
@@ -255,7 +256,8 @@ def fill_note(record: dict, harmonics) -> str:
         note += f", estimated error up to {max(p['error_estimate'] for p in ok):.1e}"
     off = [p["hbm_off"] for p in checks if p["ok"]]
     if off:
-        note += f"; there the HBM's first harmonic is off by {100 * min(off):.2g}-{100 * max(off):.2g} %"
+        span = f"{100 * min(off):.2g}" + ("" if len(off) == 1 else f"-{100 * max(off):.2g}")
+        note += f"; there the HBM's first harmonic is off by {span} %"
     bad = [p for p in record["points"] if not p["ok"]]
     if bad:
         note += f"; at {bad[0]['freq_hz']:.6g} Hz {bad[0]['message']}"
