@@ -6,6 +6,7 @@
 >>> res.freq_hz, res.outputs["x"].h1
 >>> res.table()                     # the frf.csv columns as arrays (res.to_frame() with pandas)
 >>> loops = hbm.contact_loops(case, res, res.nearest(32.0))   # forces over one period
+>>> hbm.time_fill(case, res)        # time-domain points where the path stopped short or is far off
 """
 from hbm.interface.case import Case, CaseError, case_from_dict, load_case
 
@@ -24,10 +25,18 @@ def timesim(case, freq_hz, options=None, **kwargs):
     return _timesim(case, freq_hz, options, **kwargs)
 
 
+def time_fill(case, result, budget=30.0):
+    """Time-domain points where ``result`` left its window untraced or is far off, as ``hbm frf``
+    adds them; see :func:`hbm.analyses.time_fill.fill_untraced`."""
+    from hbm.analyses.time_fill import fill_untraced, wanted
+    return fill_untraced(case, result, budget=budget) if wanted(result) else None
+
+
 def contact_loops(case, result, point):
     """Element forces and hysteresis loops at one FRF point; see :func:`hbm.balance.element_loops.contact_loops`."""
     from hbm.balance.element_loops import contact_loops as _loops
     return _loops(case, result, point)
 
 
-__all__ = ["__version__", "contact_loops", "case_from_dict", "Case", "CaseError", "load_case", "frf", "timesim"]
+__all__ = ["__version__", "contact_loops", "case_from_dict", "Case", "CaseError", "load_case", "frf", "timesim",
+           "time_fill"]

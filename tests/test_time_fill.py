@@ -109,6 +109,7 @@ def test_no_budget_simulates_nothing_and_says_so(stopped):
     from hbm.interface.cli import _time_fill
     case, res = stopped
     assert not _time_fill(case, res, SimpleNamespace(time_fill=0.0, quiet=True))     # --time-fill 0
+    assert hbm.time_fill(case, res, budget=0.0)["skipped"]                            # the API's entry
     rec = fill_untraced(case, res, budget=0.0, max_points=4)
     assert rec["points"] == [] and len(rec["skipped"]) == 4
     assert "0 of 4" in rec["note"] and "4 not simulated (budget 0 s)" in rec["note"]
