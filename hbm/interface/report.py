@@ -7,7 +7,8 @@ column ``NAME`` per element output (a per-period scalar such as ``contact.slip_f
 without such contacts), then ``H`` (the point's highest harmonic, when ``--tol`` chose them point by
 point), then ``stable`` (1/0, empty when not computed); rows follow the continuation path.  ``summary.json``
 adds ``jumps`` per output (predicted jumps of slow up and down sweeps, :mod:`hbm.analyses.jumps`) when
-the stability was computed.  ``frf.png``: :mod:`hbm.interface.frf_plot`.
+the stability was computed.  ``frf.png``: :mod:`hbm.interface.frf_plot`.  ``frf_timedomain.csv``
+(only when the time fill ran, :mod:`hbm.analyses.time_fill`): one row per time simulation.
 """
 from __future__ import annotations
 
@@ -179,7 +180,8 @@ def summary_dict(case, res, extra=None) -> dict:
 
 
 def write_frf(case, res, outdir, extra=None) -> dict:
-    """Write the three files into ``outdir`` (created); returns the summary dict."""
+    """Write the files into ``outdir`` (created; a previous run's ``frf_timedomain.csv`` is
+    removed when this one has no time fill); returns the summary dict."""
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     write_csv(res, out / "frf.csv")
