@@ -153,3 +153,11 @@ def test_a_refused_or_failed_integration_is_recorded_not_raised(monkeypatch):
     monkeypatch.setattr(ts, "timesim", refuse)
     p, q = time_fill._simulate(None, 0.5, 1.0, "x"), time_fill._simulate(None, 2.0, 1.0, "x")
     assert not p["ok"] and "40 GB" in p["message"] and not q["ok"] and "Newton" in q["message"]
+
+
+def test_a_condensed_model_is_not_filled_and_that_is_said():
+    # its time integration would run on every FE DOF
+    res = _run([4.0, 3.0, 2.0], [[0, 3]])
+    case = SimpleNamespace(reduction=SimpleNamespace(solver="condensed"))
+    assert fill_untraced(case, res) is None and "time_fill" not in res.settings
+    assert "condensed model is not integrated in time" in res.settings["time_fill_note"]

@@ -205,10 +205,15 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         ``hbm_estimate`` and ``hbm_off``, the HBM's largest relative deviation), ``skipped``
         (frequencies not simulated for the budget), ``seconds``, ``note``; None when there is
         nothing to simulate or the model is not simulated here (the condensed solver's models:
-        their time integration runs on every DOF).
+        their time integration runs on every DOF; ``settings["time_fill_note"]`` says so).
     """
     from hbm.analyses.problem_setup import choose_solver
-    if res.freq_hz.size == 0 or choose_solver(case) != "full":
+    if res.freq_hz.size == 0:
+        return None
+    if choose_solver(case) != "full":
+        res.settings["time_fill_note"] = (
+            "no time-domain points where the path stopped, left gaps or is far off: a condensed model is not "
+            "integrated in time here (hbm timesim CASE --freq-hz F integrates its full model at one frequency)")
         return None
     window = (float(res.settings["fmin_hz"]), float(res.settings["fmax_hz"]))
     stretches = untraced_stretches(res)

@@ -134,7 +134,7 @@ def _check_outdir(path):
 
 def _time_fill(case, res, args) -> bool:
     """Time-simulate what the run left untraced or estimates far off (``--time-fill`` seconds;
-    the HBM files are already on disk); True when points were added to ``res.settings``."""
+    the HBM files are already on disk); True when ``res.settings`` gained points or a note."""
     from hbm.analyses.time_fill import fill_untraced, wanted
     from hbm.interface.progress import CountProgress
     if args.time_fill <= 0 or not wanted(res):
@@ -146,7 +146,8 @@ def _time_fill(case, res, args) -> bool:
             bar.resize(total)
             bar(done)
     try:
-        return fill_untraced(case, res, budget=args.time_fill, progress=progress) is not None
+        return (fill_untraced(case, res, budget=args.time_fill, progress=progress) is not None
+                or "time_fill_note" in res.settings)
     finally:
         if bar is not None:
             bar.close()

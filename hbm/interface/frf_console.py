@@ -58,6 +58,8 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
         print(f"  note: {st['aft_retry']['note']}")
     if st.get("time_fill"):
         print(f"  note: {st['time_fill']['note']}")
+    elif st.get("time_fill_note"):
+        print(f"  note: {st['time_fill_note']}")
     if st.get("floquet_overrides_hz"):
         fl = st["floquet_overrides_hz"]
         print(f"  note: {len(fl)} point(s) Hill called unstable are stable by the Floquet multipliers of the "
