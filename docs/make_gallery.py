@@ -84,8 +84,8 @@ def main(names=()) -> None:
     old = index.read_text().splitlines() if names and index.exists() else []
     out = list(HEADER)
     for case in cases:
-        kept = [x for x in old if x.startswith(f"- [`{case.stem}`]")]
-        out.append(kept[0] if case.stem not in names and kept and names else rig_page(case))
+        kept = [x for x in old if x.startswith(f"- [`{case.stem}`]")]     # empty unless names
+        out.append(kept[0] if kept and case.stem not in names else rig_page(case))
     index.write_text("\n".join(out))
     print(f"wrote {index}")
 

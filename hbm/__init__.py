@@ -25,11 +25,11 @@ def timesim(case, freq_hz, options=None, **kwargs):
     return _timesim(case, freq_hz, options, **kwargs)
 
 
-def time_fill(case, result, budget=30.0):
+def time_fill(case, result, budget=30.0, progress=None):
     """Time-domain points where ``result`` left its window untraced or is far off, as ``hbm frf``
-    adds them; see :func:`hbm.analyses.time_fill.fill_untraced`."""
+    adds them (None when there is no such place); see :func:`hbm.analyses.time_fill.fill_untraced`."""
     from hbm.analyses.time_fill import fill_untraced, wanted
-    return fill_untraced(case, result, budget=budget) if wanted(result) else None
+    return fill_untraced(case, result, budget=budget, progress=progress) if wanted(result) else None
 
 
 def contact_loops(case, result, point):

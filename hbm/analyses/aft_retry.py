@@ -19,6 +19,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 
+from hbm.analyses.time_fill import untraced_stretches
+
 STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
 RETRY_SECONDS = 60.0        # a first run longer than this is not repeated (its hint says how)
 SHARE = 0.9                 # the events run is kept if it leaves at most this share untraced
@@ -46,7 +48,6 @@ def stiff_sampled_contacts(case) -> list:
 def untraced_hz(res) -> float:
     """Width of the window (Hz) that no traced segment of a run covers
     (:func:`hbm.analyses.time_fill.untraced_stretches`)."""
-    from hbm.analyses.time_fill import untraced_stretches
     return sum(b - a for a, b in untraced_stretches(res))
 
 

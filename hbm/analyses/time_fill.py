@@ -148,10 +148,10 @@ def _worst_errors(res):
     return np.nan_to_num(np.array(errs), nan=0.0).max(axis=0) if errs and res.freq_hz.size else None
 
 
-def check_points(res, k: int) -> list:
+def check_points(res, k: int, worst=None) -> list:
     """Up to ``k`` path indices of points estimated more than ``UNRELIABLE`` off, spread over
-    their frequencies."""
-    worst = _worst_errors(res)
+    their frequencies (``worst``: :func:`_worst_errors` of ``res``, when at hand)."""
+    worst = _worst_errors(res) if worst is None else worst
     if worst is None or k <= 0:
         return []
     idx = np.flatnonzero(worst > UNRELIABLE)
@@ -169,10 +169,11 @@ def wanted(res) -> bool:
             or (worst is not None and bool(np.nanmax(worst) > UNRELIABLE)))
 
 
-def _compare(p: dict, res, i: int) -> dict:
-    """A time-domain point at path point ``i``, with the HBM's first harmonics beside it."""
+def _compare(p: dict, res, i: int, estimate: float) -> dict:
+    """A time-domain point at path point ``i`` (estimated ``estimate`` off), with the HBM's
+    first harmonics beside it."""
     hbm = {n: float(o.h1[i]) for n, o in res.outputs.items()}
-    p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(_worst_errors(res)[i])}
+    p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(estimate)}
     if p["ok"]:
         p["hbm_off"] = max((abs(hbm[n] / p["h1"][n] - 1.0) for n in hbm if p["h1"][n] != 0.0),
                            default=float("nan"))
@@ -217,10 +218,11 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         return None
     window = (float(res.settings["fmin_hz"]), float(res.settings["fmax_hz"]))
     stretches = untraced_stretches(res)
-    n_checks = max_points // 3 if check_points(res, 1) else 0
+    worst = _worst_errors(res)
+    n_checks = max_points // 3 if worst is not None and np.any(worst > UNRELIABLE) else 0
     freqs = fill_frequencies(stretches, window, max_points - n_checks)
     todo = [(f, None) for fs in freqs for f in fs]
-    todo += [(float(res.freq_hz[i]), i) for i in check_points(res, max_points - len(todo))]
+    todo += [(float(res.freq_hz[i]), i) for i in check_points(res, max_points - len(todo), worst)]
     if not todo:
         return None
     t0, points, skipped = time.perf_counter(), [], []
@@ -233,7 +235,7 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         share = POINT_SHARE * budget
         why = "a point's share of the budget" if share < left else "the budget ran out"
         p = {"kind": "untraced", **_simulate(case, f, min(left, share), why)}
-        points.append(p if i is None else _compare(p, res, i))
+        points.append(p if i is None else _compare(p, res, i, worst[i]))
         if progress is not None:
             progress(len(points), len(todo))
     points.sort(key=lambda p: p["freq_hz"])

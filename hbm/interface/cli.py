@@ -137,7 +137,7 @@ def _time_fill(case, res, args) -> bool:
     the HBM files are already on disk); True when ``res.settings`` gained points or a note."""
     from hbm.analyses.time_fill import fill_untraced, wanted
     from hbm.interface.progress import CountProgress
-    if args.time_fill <= 0 or not wanted(res):
+    if args.time_fill <= 0 or not wanted(res):        # no bar for a run with nothing to fill
         return False
     bar = None if args.quiet else CountProgress(1, "point", "time domain")
 
