@@ -9,7 +9,11 @@ confirm_unstable`); those points are listed as Hill's disagreements.  A verdict 
 shooting converged; ``distance`` says how far (relative) the time solution lies from the
 balance point (large: the balance point is inaccurate at its H, or another branch).
 
-    python benchmarks/floquet_vs_hill.py [--every 2] [--steps 1024]
+    python benchmarks/floquet_vs_hill.py [--every 2] [--steps 1024] [--cases duffing,upd_like,...]
+
+The condensed cases (``upd_like``, ``upd_rig_flanks``) are checked on the model the condensed
+balance solves, its kept modes and residual flexibility in the time domain
+(:mod:`hbm.timedomain.condensed_twin`).
 
 Writes benchmarks/results/floquet_vs_hill.csv and prints the agreement per case; then runs
 the time integration from rest at a few frequencies and checks that the FRF point it settles
@@ -31,6 +35,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import hbm                                     # noqa: E402
 from hbm.interface.case import case_from_dict, load_case  # noqa: E402
+from hbm.analyses.problem_setup import build_problem      # noqa: E402
 from hbm.timedomain.floquet_check import check_point      # noqa: E402
 
 
@@ -52,6 +57,8 @@ def cases():
         "sdof_jenkins": lambda: load_case(ROOT / "rigs" / "sdof_jenkins.toml"),
         "three_dof_two_jenkins": target_case,
         "blade_couple": lambda: load_case(ROOT / "rigs" / "blade_couple.toml"),
+        "upd_like": lambda: load_case(ROOT / "benchmarks" / "upd_like.toml"),
+        "upd_rig_flanks": lambda: load_case(ROOT / "rigs" / "upd_rig_flanks.toml"),
     }
 
 
@@ -60,10 +67,13 @@ def study(name, case, every, steps):
     res = hbm.frf(case)
     t_frf = time.perf_counter() - t0
     pick = sorted(set(range(0, res.freq_hz.size, every)) | set(np.flatnonzero(~res.stable)))
+    problem = None
+    if res.settings["solver"] == "condensed":      # checked on its kept modes + residual flexibility
+        problem = build_problem(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])[0]
     rows = []
     t0 = time.perf_counter()
     for i in pick:
-        c = check_point(case, res.basis, res.X[i], float(res.freq_hz[i]), steps=steps)
+        c = check_point(case, res.basis, res.X[i], float(res.freq_hz[i]), steps=steps, problem=problem)
         rows.append(dict(case=name, freq_hz=float(res.freq_hz[i]), hill_stable=bool(res.stable[i]),
                          floquet_stable=c.stable, largest_multiplier=c.largest, converged=c.converged,
                          distance=c.distance, message=c.message))

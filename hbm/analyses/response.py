@@ -137,8 +137,7 @@ def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, option
     jumps = None
     if stable is not None:
         t1 = time.perf_counter()
-        if choose_solver(case) == "full":
-            stable = confirm_unstable(case, basis, Xs, freq_hz, stable, settings)
+        stable = confirm_unstable(case, basis, Xs, freq_hz, stable, settings, problem)
         jumps = _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, stability_options)
         settings["stability_seconds"] += time.perf_counter() - t1        # + Floquet checks, jumps
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))

@@ -344,17 +344,25 @@ class CondensedLinear:
         ye = L.Hx[i1, :ne, nc:] @ fe - L.Hx[i1, :ne, :nc] @ fp[i1]   # y_e = H_ee F_e - H_ec F'
         w_ex = -np.pi * float(np.vdot(fe, ye).imag)
         # modal amplitudes under F_e and -F' (the mean, W = 0, does no work)
+        v = (1j * self._h * w)[:, None] * self._modal(fp, w)
+        w_v = float(np.vdot(v, v @ r.modal_c.T).real)
+        return w_ex, np.pi / w * w_v, np.pi * float(np.linalg.norm(fe) * np.linalg.norm(ye))
+
+    def _modal(self, fp: np.ndarray, w: float) -> np.ndarray:
+        """Modal amplitudes ``eta`` (n_h, m) complex under ``F_e`` and the contact forces
+        ``-fp`` (n_h, n_c) complex: ``(Omega^2 - W^2 + i W C_m) eta = Phi_e^T F_e - Phi_c^T fp``."""
+        r = self.reduced
         W = self._h * w
         iW = (1j * W)[:, None]
         g = self._ge - fp @ self._phi["c"]                           # (n_h, m)
-        Cm = r.modal_c
         if r.proportional:
-            eta = g / (self._om2 - (W * W)[:, None] + iW * self._cdiag)
-        else:
-            D = iW[:, :, None] * Cm
-            ar = np.arange(self._om2.size)
-            D[:, ar, ar] += self._om2 - (W * W)[:, None]
-            eta = np.linalg.solve(D, g[:, :, None])[:, :, 0]
-        v = iW * eta
-        w_v = float(np.vdot(v, v @ Cm.T).real)
-        return w_ex, np.pi / w * w_v, np.pi * float(np.linalg.norm(fe) * np.linalg.norm(ye))
+            return g / (self._om2 - (W * W)[:, None] + iW * self._cdiag)
+        D = iW[:, :, None] * r.modal_c
+        ar = np.arange(self._om2.size)
+        D[:, ar, ar] += self._om2 - (W * W)[:, None]
+        return np.linalg.solve(D, g[:, :, None])[:, :, 0]
+
+    def modal_coefficients(self, X: np.ndarray, w: float) -> np.ndarray:
+        """Coefficients (n_coef, m) of the kept modes' coordinates at the balance point ``X``
+        (n_coef, n_c), under the excitation and the contact forces the balance implies."""
+        return self._real(self._modal(self._implied_forces(X, self.at(w)), w))

@@ -81,12 +81,27 @@ def set_state(state, y: np.ndarray, laws) -> None:
     element_forces(laws, state.S, state.fnl)
 
 
-def start_sensitivity(n: int, n_s: int, fixed: np.ndarray) -> np.ndarray:
-    """``dy/dy`` at the period's start: the identity, without the support DOFs (prescribed)."""
+def static_dofs(model) -> np.ndarray:
+    """Flags (n,) of the DOFs without mass and damping (rows of ``M`` and ``C`` zero): their
+    equations are static, so their velocities and accelerations are by-products of the scheme
+    that nothing reads (the condensed model's residual flexibility,
+    :mod:`hbm.timedomain.condensed_twin`)."""
+    M, C = model[0], model[1]
+    return ~np.any(M != 0.0, axis=1) & ~np.any(C != 0.0, axis=1)
+
+
+def start_sensitivity(n: int, n_s: int, fixed: np.ndarray, static: np.ndarray | None = None) -> np.ndarray:
+    """``dy/dy`` at the period's start: the identity, without the support DOFs (prescribed)
+    and without the velocities and accelerations of ``static`` DOFs (:func:`static_dofs`;
+    their trapezoidal recurrences would add multipliers of exactly 1 that no motion has)."""
     Y = np.eye(3 * n + n_s)
     for b in range(3):
         idx = b * n + np.flatnonzero(fixed)
         Y[idx, idx] = 0.0
+    if static is not None:
+        for b in (1, 2):
+            idx = b * n + np.flatnonzero(static)
+            Y[idx, idx] = 0.0
     return Y
 
 
@@ -105,11 +120,12 @@ class Balance:
 
     ``a_f = M_ff^{-1}(F_c - C v - K q - G^T P S - M_fs a_s)_f`` on the free DOFs, ``a_s =
     -w^2 y_b`` on the supports; ``da/d[q, v, S]`` (n, 2 n + n_S) is zero on support rows.
+    Static DOFs (:func:`static_dofs`) have no acceleration: zero, like their rows of ``J``.
     """
 
     def __init__(self, model, laws, w):
         M, C, K, F2, fixed, ybase = model
-        self.fr = np.flatnonzero(fixed == 0)
+        self.fr = np.flatnonzero((fixed == 0) & ~static_dofs(model))
         self.fx = np.flatnonzero(fixed)
         self.M, self.C, self.K, self.F0 = M, C, K, F2[0]
         self.a_fixed = -w * w * ybase[self.fx]
@@ -199,6 +215,7 @@ def shoot(one_period, state, model, laws, w: float, tol: float,
     """
     n = model[0].shape[0]
     n_s = state.S.size
+    static = static_dofs(model)
     balance = Balance(model, laws, w)
     residuals = []
     best = None                  # (residual, r, Newton step) of the best point so far
@@ -207,7 +224,7 @@ def shoot(one_period, state, model, laws, w: float, tol: float,
     _set_reduced(state, _reduced(state_vector(state), n), laws, balance, n)
     for it in range(1, max_iter + 1):
         r0 = _reduced(state_vector(state), n)
-        Y = start_sensitivity(n, n_s, model[4])
+        Y = start_sensitivity(n, n_s, model[4], static)
         q_hist = one_period(state, Y)
         r1 = _reduced(state_vector(state), n)
         Yr = reduced_monodromy(Y, balance, n)
