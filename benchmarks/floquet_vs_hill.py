@@ -98,13 +98,20 @@ def study(name, case, every, steps):
 
 def from_rest(name, case, res, freqs, steps):
     """``hbm timesim`` from rest at ``freqs``: the FRF point it settles on (the crossing of the
-    path at that frequency with the nearest amplitude) must not be called unstable."""
+    path at that frequency with the nearest amplitude) must not be called unstable.  A
+    condensed case is integrated on the model its balance solves (kept modes + residual
+    flexibility)."""
+    from hbm.timedomain.floquet_check import time_model
     from hbm.timedomain.timesim import TimeSimOptions, steady_state
     out = next(iter(case.analysis.outputs))
     f, a = res.freq_hz, res.outputs[out].h1
+    model = case
+    if freqs and res.settings["solver"] == "condensed":
+        model = time_model(case, build_problem(case, res.basis, res.settings["transform"],
+                                               res.settings["fmax_hz"])[0])[0]
     bad = 0
     for fq in freqs:
-        run = steady_state(case, fq, TimeSimOptions(steps=steps))
+        run = steady_state(model, fq, TimeSimOptions(steps=steps))
         cross = np.flatnonzero((f[:-1] - fq) * (f[1:] - fq) <= 0)
         amps = [a[i] + (a[i + 1] - a[i]) * (fq - f[i]) / (f[i + 1] - f[i]) if f[i + 1] != f[i] else a[i]
                 for i in cross]
@@ -119,7 +126,8 @@ def from_rest(name, case, res, freqs, steps):
 
 
 REST = {"duffing": (0.22, 0.26, 0.30), "blade_couple": (116.0, 119.0, 120.46, 121.0, 123.0),
-        "three_dof_two_jenkins": (15.0, 22.0, 30.0)}
+        "three_dof_two_jenkins": (15.0, 22.0, 30.0), "upd_like": (241.64, 256.0, 263.0),
+        "upd_rig_flanks": (300.0, 306.0, 310.0)}
 
 
 def main(argv=None):

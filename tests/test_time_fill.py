@@ -52,10 +52,10 @@ def test_spread_order_covers_the_range_early():
     assert spread_order(1) == [0]
 
 
-def _stiff_oscillator():
+def _stiff_oscillator(**model):
     return case_from_dict({
         "name": "undamped Jenkins, kt/k = 1e5",
-        "model": {"mass": [[1.0]], "stiffness": [[1.0]], "damping": [[0.0]]},
+        "model": {"mass": [[1.0]], "stiffness": [[1.0]], "damping": [[0.0]], **model},
         "element": [{"type": "jenkins", "dofs": [0], "kt": 1e5, "slip_force": 0.9}],
         "excitation": {"dofs": [0], "amplitude": [1.0]},
         "analysis": {"harmonics": 15, "frequency_hz": [0.086, 0.2], "outputs": {"x": 0}},
@@ -155,9 +155,33 @@ def test_a_refused_or_failed_integration_is_recorded_not_raised(monkeypatch):
     assert not p["ok"] and "40 GB" in p["message"] and not q["ok"] and "Newton" in q["message"]
 
 
-def test_a_condensed_model_is_not_filled_and_that_is_said():
-    # its time integration would run on every FE DOF
-    res = _run([4.0, 3.0, 2.0], [[0, 3]])
-    case = SimpleNamespace(reduction=SimpleNamespace(solver="condensed"))
-    assert fill_untraced(case, res) is None and "time_fill" not in res.settings
-    assert "condensed model is not integrated in time" in res.settings["time_fill_note"]
+def test_a_condensed_model_is_filled_on_the_model_its_balance_solves(stopped):
+    """The condensed solver's run of the same oscillator (its one mode kept) is the full one's
+    and stops as well; it is simulated on its kept modes (:mod:`hbm.timedomain.condensed_twin`): the point at the
+    window's start equals the full model's."""
+    case, res = stopped
+    cond = _stiff_oscillator(solver="condensed", modes=1)
+    rc = hbm.frf(cond, stability=False)
+    assert rc.settings["solver"] == "condensed" and rc.status == "failed"
+    # the same run as the full solver's, retried with aft = "events" like it (a stiff contact)
+    assert "aft_retry" in rc.settings and rc.freq_hz.size == res.freq_hz.size
+    assert np.allclose(rc.outputs["x"].h1, res.outputs["x"].h1, rtol=1e-6)
+    a = fill_untraced(case, res, budget=10.0, max_points=1)
+    b = fill_untraced(cond, rc, budget=10.0, max_points=1)
+    (pa,), (pb,) = a["points"], b["points"]
+    assert pa["freq_hz"] == pb["freq_hz"] == 0.086 and pa["ok"] and pb["ok"]
+    assert abs(pb["h1"]["x"] / pa["h1"]["x"] - 1) < 1e-8 and "time_fill_note" not in rc.settings
+
+
+def test_a_condensed_model_with_a_velocity_law_is_not_filled_and_that_is_said():
+    # the twin's static coordinates have no velocity a law could read
+    from hbm.analyses import time_fill
+    cond = case_from_dict({
+        "model": {"mass": [[1.0]], "stiffness": [[1.0]], "damping": [[0.01]], "solver": "condensed", "modes": 1},
+        "element": [{"type": "coulomb_regularised", "dofs": [0], "slip_force": 0.2, "v_r": 0.01}],
+        "excitation": {"dofs": [0], "amplitude": [1.0]},
+        "analysis": {"harmonics": 3, "frequency_hz": [0.1, 0.2], "outputs": {"x": 0}},
+    })
+    res = hbm.frf(cond, stability=False)
+    assert time_fill._time_model(cond, res) is None
+    assert "velocity-dependent law is not integrated in time" in res.settings["time_fill_note"]

@@ -19,6 +19,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 
+import numpy as np
+
 from hbm.analyses.time_fill import untraced_stretches
 
 STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
@@ -28,18 +30,15 @@ SHARE = 0.9                 # the events run is kept if it leaves at most this s
 
 def stiff_sampled_contacts(case) -> list:
     """``(index, kt / k_structure)`` of the elements that offer ``aft = "events"``, are sampled
-    and are stiff (module doc); empty unless the model is dense (a condensed model's
-    stiffness along a contact is not at hand)."""
-    from hbm.analyses.problem_setup import choose_solver
-    if choose_solver(case) != "full":
-        return []
-    K = case.model.K
+    and are stiff (module doc), on the full or the condensed solver (the structure's
+    stiffness matrix as given, dense or sparse)."""
+    K = case.structure.K
     out = []
     for i, e in enumerate(case.elements):
         if not e.events_available or e.aft != "sampled":
             continue
-        g = e.gather[0]
-        ks = float(g @ K @ g) / float(g @ g)
+        g = np.asarray(e.gather[0], dtype=float)
+        ks = float(g @ (K @ g)) / float(g @ g)
         if ks > 0 and e.kt >= STIFF_CONTACT * ks:
             out.append((i, e.kt / ks))
     return out

@@ -150,6 +150,29 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
     return problem, info
 
 
+def condensed_time_model(case: Case):
+    """The model the condensed solver's balance of ``case`` solves (kept modes and residual
+    flexibility) as the time integrator steps it (:mod:`hbm.timedomain.condensed_twin`).
+
+    Raises
+    ------
+    CaseError
+        The case is solved on the full model, or a law reads velocities (the twin's static
+        coordinates have none).
+    """
+    from hbm.timedomain.floquet_check import time_model
+    from hbm.timedomain.time_parts import pack_elements
+    if choose_solver(case) != "condensed":
+        raise CaseError(f"{case.path}: --condensed integrates the condensed solver's model, but this case is "
+                        f"solved on its full model (set [model] solver = \"condensed\")")
+    h, N, lo, hi, tr = resolve_settings(case)
+    model, _ = time_model(case, build_problem(case, FourierBasis(h, N), tr, hi)[0])
+    if np.any(pack_elements(model.elements, model.n_dof).laws[6]):
+        raise CaseError(f"{case.path}: --condensed cannot integrate a velocity-dependent law "
+                        f"(the residual flexibility's coordinates have no velocity)")
+    return model
+
+
 def recover_outputs(problem, case: Case, X: np.ndarray, w: float) -> np.ndarray:
     """Output coefficients (n_coef, n_outputs) of a point ``X`` (n_coef, n) at ``w``
     (``problem.recover_outputs``: the problem was built with ``case``'s outputs)."""

@@ -8,7 +8,8 @@ the contact's stick range :math:`2 F_s / k_t`, so the penalty law chatters and N
 more continuation cannot help, but the time integration can: :func:`fill_untraced` runs the
 steady-state time simulation (:func:`hbm.timedomain.timesim.timesim`, Newmark with located
 switches and an ``n`` / ``2 n`` error estimate) at points spread over the untraced stretches,
-within a time budget.  The points are kept apart from the HBM path (``settings["time_fill"]``,
+within a time budget.  A condensed model is simulated on the model its balance solves, the
+kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`).  The points are kept apart from the HBM path (``settings["time_fill"]``,
 ``frf_timedomain.csv``, markers in ``frf.png``): they carry no harmonic coefficients.
 
 The same simulations check the traced points estimated more than ``UNRELIABLE`` off (up to a
@@ -180,6 +181,26 @@ def _compare(p: dict, res, i: int, estimate: float) -> dict:
     return p
 
 
+def _time_model(case, res):
+    """What the time simulations step: ``case`` for the full solver; for the condensed one its
+    kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`), the model its
+    balance solves, unless a law reads velocities (the static coordinates have none)."""
+    from hbm.analyses.problem_setup import build_problem, choose_solver
+    from hbm.timedomain.floquet_check import time_model
+    from hbm.timedomain.time_parts import pack_elements
+    if choose_solver(case) == "full":
+        return case
+    problem, _ = build_problem(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])
+    model, _ = time_model(case, problem)
+    if np.any(pack_elements(model.elements, model.n_dof).laws[6]):
+        res.settings["time_fill_note"] = (
+            "no time-domain points where the path stopped, left gaps or is far off: a condensed model with a "
+            "velocity-dependent law is not integrated in time here (hbm timesim CASE --freq-hz F integrates "
+            "its full model at one frequency)")
+        return None
+    return model
+
+
 def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = MAX_POINTS,
                   progress=None) -> dict | None:
     """Time-simulate the stretches of the window that ``res`` left untraced, and the traced
@@ -205,16 +226,11 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         ``error_estimate``, ``periods``, ``seconds``, ``message``; a check also ``hbm_h1``,
         ``hbm_estimate`` and ``hbm_off``, the HBM's largest relative deviation), ``skipped``
         (frequencies not simulated for the budget), ``seconds``, ``note``; None when there is
-        nothing to simulate or the model is not simulated here (the condensed solver's models:
-        their time integration runs on every DOF; ``settings["time_fill_note"]`` says so).
+        nothing to simulate or the model is not simulated here (a condensed model with a
+        velocity-dependent law; ``settings["time_fill_note"]`` says so).
     """
-    from hbm.analyses.problem_setup import choose_solver
-    if res.freq_hz.size == 0:
-        return None
-    if choose_solver(case) != "full":
-        res.settings["time_fill_note"] = (
-            "no time-domain points where the path stopped, left gaps or is far off: a condensed model is not "
-            "integrated in time here (hbm timesim CASE --freq-hz F integrates its full model at one frequency)")
+    model = _time_model(case, res)
+    if model is None:
         return None
     window = (float(res.settings["fmin_hz"]), float(res.settings["fmax_hz"]))
     stretches = untraced_stretches(res)
@@ -234,7 +250,7 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
             continue
         share = POINT_SHARE * budget
         why = "a point's share of the budget" if share < left else "the budget ran out"
-        p = {"kind": "untraced", **_simulate(case, f, min(left, share), why)}
+        p = {"kind": "untraced", **_simulate(model, f, min(left, share), why)}
         points.append(p if i is None else _compare(p, res, i, worst[i]))
         if progress is not None:
             progress(len(points), len(todo))

@@ -53,7 +53,10 @@ class _Excitation:
 
 @dataclass(frozen=True)
 class _Analysis:
+    """Outputs ``y = g . q + d_c cos(w t) + d_s sin(w t)``: rows ``g`` (n,) by name in
+    ``outputs``, the excitation's direct part ``(d_c, d_s)`` by name in ``feed``."""
     outputs: dict = field(default_factory=dict)
+    feed: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -88,12 +91,17 @@ class TimeTwin:
         return self.B.shape[1]
 
 
-def time_twin(linear, name: str = "", path: str = "") -> TimeTwin:
+def time_twin(linear, name: str = "", path: str = "", outputs=()) -> TimeTwin:
     """The time-domain model of a condensed linear part with its elements.
 
     Parameters
     ----------
     linear : hbm.balance.condensed.CondensedLinear
+    outputs : sequence of str
+        Names of the linear part's output rows, in order (``[analysis] outputs``).  An output
+        ``y = G_o q`` is ``Phi_o eta + R_oc(-f) + R_oe F_e(t)``, and ``R_oc(-f)`` depends only
+        on ``V^T(-f) = diag(1/r)(s - V^T R_ce F_e(t))``: a row over ``y`` plus a direct part
+        of the excitation.
     """
     cm, red = linear.condensed, linear.reduced
     R = red.residual
@@ -118,7 +126,13 @@ def time_twin(linear, name: str = "", path: str = "") -> TimeTwin:
         F2[k, m:] = (V.T @ R_ce[:, k]) / r
     B = np.hstack([phi_c, V])
     elems = tuple(regathered(e, e.gather @ B) for e in linear.elements)
-    return TimeTwin(name, path, _Model(M, C, K), elems, _Excitation(F2), B, V, m)
+    R_oc, R_oe = cm.G_o @ R @ cm.G_c.T, cm.G_o @ R @ cm.G_e.T
+    rows = np.hstack([cm.G_o @ red.phi, (R_oc @ V) / r])
+    direct = R_oe - ((R_oc @ V) / r) @ (V.T @ R_ce)                  # (n_o, n_e): cosine, sine
+    feed = np.zeros((rows.shape[0], 2))
+    feed[:, :direct.shape[1]] = direct
+    analysis = _Analysis({k: rows[i] for i, k in enumerate(outputs)}, {k: feed[i] for i, k in enumerate(outputs)})
+    return TimeTwin(name, path, _Model(M, C, K), elems, _Excitation(F2), B, V, m, analysis)
 
 
 def twin_coefficients(linear, twin: TimeTwin, X: np.ndarray, w: float) -> np.ndarray:

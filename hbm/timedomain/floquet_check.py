@@ -104,7 +104,7 @@ def time_model(case, problem=None):
     linear = getattr(problem, "linear", None)
     if linear is None or not hasattr(linear, "condensed"):
         return case, lambda X, w: X
-    twin = time_twin(linear, case.name, case.path)
+    twin = time_twin(linear, case.name, case.path, list(case.analysis.outputs))
     return twin, lambda X, w: twin_coefficients(linear, twin, X, w)
 
 

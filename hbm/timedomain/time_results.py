@@ -162,3 +162,17 @@ class TimeSimResult:
     @property
     def history(self) -> History:
         return self.fine.history
+
+
+def output_series(case, q: np.ndarray, t: np.ndarray, w: float) -> dict:
+    """Each output's values ``y = q g`` (n_rows,) at the rows of ``q`` (n_rows, n), times ``t``;
+    with the excitation's direct part ``d_c cos(w t) + d_s sin(w t)`` of a condensed model's
+    time twin (``analysis.feed``, :mod:`hbm.timedomain.condensed_twin`)."""
+    feed = getattr(case.analysis, "feed", {})
+    out = {}
+    for name, g in case.analysis.outputs.items():
+        y = q @ g
+        if name in feed:
+            y = y + feed[name][0] * np.cos(w * t) + feed[name][1] * np.sin(w * t)
+        out[name] = y
+    return out

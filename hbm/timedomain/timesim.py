@@ -84,7 +84,7 @@ from hbm.timedomain.time_march import march
 from hbm.timedomain.time_parts import pack_elements
 from hbm.timedomain.shooting import (MAX_NEWTON, Balance, floquet_verdict, reduced_monodromy, shoot, start_sensitivity,
                                       static_dofs)
-from hbm.timedomain.time_results import History, Run, TimeSimOptions, TimeSimResult
+from hbm.timedomain.time_results import History, Run, TimeSimOptions, TimeSimResult, output_series
 from hbm.timedomain.time_state import TimeState, kernel_model
 
 __all__ = ["History", "Run", "TimeSimOptions", "TimeSimResult", "steady_state", "timesim", "transient"]
@@ -112,13 +112,11 @@ def _check_freq(freq_hz):
     return f
 
 
-def _amplitudes(case: Case, hist: History, N: int):
+def _amplitudes(case: Case, hist: History, N: int, w: float):
     """``h1`` and ``max`` per output over the last ``N + 1`` rows (one period)."""
-    q = hist.q[-(N + 1):]
     th = 2.0 * np.pi * np.arange(1, N + 1) / N
     h1, mx = {}, {}
-    for name, g in case.analysis.outputs.items():
-        xo = q @ g
+    for name, xo in output_series(case, hist.q[-(N + 1):], hist.t[-(N + 1):], w).items():
         x = xo[1:]
         a = 2.0 / N * np.dot(x, np.cos(th))
         b = 2.0 / N * np.dot(x, np.sin(th))
@@ -184,7 +182,7 @@ def _integrate(case, freq_hz, opts: TimeSimOptions, steps, periods, check, t_off
     else:
         t = np.arange(rows) * (T / N)
     hist = History(t, rec_q, rec_f, rec_u, packed.names, rec_v)
-    h1, mx = _amplitudes(case, hist, N)
+    h1, mx = _amplitudes(case, hist, N, w)
     st = {"newton_iterations": int(stats[0]), "substeps": int(stats[1]),
           "refinements": int(stats[2]), "newton_failures": int(stats[3])}
     return Run(freq_hz, N, done, bool(status == 1), float(change), h1, mx, hist, st, secs)

@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from hbm.timedomain.time_results import output_series
+
 
 def write_summary_csv(case, res, path: Path) -> None:
     names = list(case.analysis.outputs)
@@ -39,7 +41,8 @@ def write_history_csv(case, res, path: Path) -> None:
     hist = res.history
     outs = case.analysis.outputs
     n_f = hist.forces.shape[1]
-    cols = [hist.t] + [hist.q @ g for g in outs.values()] + [hist.forces[:, i] for i in range(n_f)]
+    ys = output_series(case, hist.q, hist.t, 2.0 * np.pi * res.freq_hz)
+    cols = [hist.t] + [ys[k] for k in outs] + [hist.forces[:, i] for i in range(n_f)]
     cols += [hist.disp[:, i] for i in range(n_f)]
     cols += [hist.vel[:, i] for i in range(n_f)]
     names = ["t"] + list(outs) + list(hist.force_names)
@@ -71,8 +74,8 @@ def write_plot(case, res, path: Path) -> None:
     n_f = hist.forces.shape[1]
     fig, axes = plt.subplots(1, 2 if n_f else 1, figsize=(11 if n_f else 7, 4.2), squeeze=False)
     ax = axes[0, 0]
-    for name, g in case.analysis.outputs.items():
-        ax.plot(hist.t, hist.q @ g, lw=0.9, label=name)
+    for name, y in output_series(case, hist.q, hist.t, 2.0 * np.pi * res.freq_hz).items():
+        ax.plot(hist.t, y, lw=0.9, label=name)
     if res.switch_off_at is not None:
         ax.axvline(res.switch_off_at, color="0.5", ls=":", lw=0.8, label="force off")
     ax.set_xlabel("time (s)")
