@@ -242,3 +242,31 @@ outputs = {{ x = 1, c = 4 }}
     assert main(["timesim", str(tmp_path / "full.toml"), "--freq-hz", "0.14", "--condensed", "-q",
                  "-o", str(out)]) == 2
     assert "solved on its full model" in capsys.readouterr().err
+
+
+def test_runs_of_unstable_points_are_confirmed_by_their_middle(monkeypatch):
+    """Runs are checked shortest first, each by its middle point; a run whose middle Floquet
+    calls stable is checked point by point; the cap leaves the rest to Hill, counted."""
+    from hbm.timedomain import floquet_check as fc
+    case = duffing_chain("full")
+    freq = np.arange(20.0)
+    stable = np.ones(20, dtype=bool)
+    stable[[2, 3, 4, 5, 6, 9, 12, 13, 14]] = False             # runs 2-6, 9, 12-14
+    truly_stable = {9.0, 12.0, 13.0}                            # Floquet's verdicts
+    asked = []
+
+    def fake(case, basis, X, f, steps, problem):
+        asked.append(f)
+        return fc.FloquetCheck(f in truly_stable, 1.0, True, 0.0, "")
+    monkeypatch.setattr(fc, "check_point", fake)
+    Xs = np.zeros((20, 3, case.n_dof))
+    st = {}
+    out = fc.confirm_unstable(case, None, Xs, freq, stable, st)
+    assert asked == [9.0, 13.0, 12.0, 14.0, 4.0]                # shortest first; 12-14 turned, so all of it
+    assert list(np.flatnonzero(~out)) == [2, 3, 4, 5, 6, 14]
+    assert st == {"floquet_checked": 5, "floquet_overrides_hz": [9.0, 12.0, 13.0]}
+    monkeypatch.setattr(fc, "MAX_CONFIRM", 3)
+    asked.clear()
+    st = {}
+    out = fc.confirm_unstable(case, None, Xs, freq, stable, st)
+    assert asked == [9.0, 13.0, 12.0] and st["floquet_unchecked"] == 1 + 5     # 14, and the run 2-6

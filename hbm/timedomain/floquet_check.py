@@ -158,7 +158,7 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
 
 MAX_CONFIRM = 40            # Hill-unstable points checked per FRF at most
 MAX_STATE = 400             # 3 n + n_S above which the check is not run (cost ~ m n^2 per step)
-CONFIRM_STEPS = 1024
+CONFIRM_STEPS = 256         # the FRF's own checks: the verdicts of 1024 steps at a quarter of the cost
 
 
 def _non_smooth(packed) -> bool:
@@ -182,6 +182,10 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     and a converged Floquet verdict replaces Hill's.  ``settings["floquet_checked"]`` counts
     the checks, ``settings["floquet_overrides_hz"]`` lists the points turned stable and
     ``settings["floquet_unchecked"]`` counts the unstable points left unchecked by the cap.
+    The checks take ``CONFIRM_STEPS`` steps per period: at 25 points of ``upd_like``, 24 of
+    the UPD flanks rig's (unstable ones included) and the blade couple's overridden point the
+    verdicts of 256 steps are those of 1024 wherever both converged, the largest multipliers
+    1e-5 apart on stable points and up to 2 % on unstable ones.
 
     Parameters
     ----------
