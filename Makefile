@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/hbm frf rigs/sdof_jenkins.toml -o $(VENV)/warmup > /dev/null 2>&1
 	$(BIN)/hbm frf rigs/inclined_contact.toml -o $(VENV)/warmup > /dev/null 2>&1
 	$(BIN)/python -c "from elements.friction2d_events import compile_kernels; compile_kernels()"
-	@echo "compiling the time integrator and its period map (Floquet checks of unstable points)"
+	@echo "compiling the time integrator and its period map (about 55 s, once: Floquet checks, time fill)"
 	$(BIN)/hbm timesim rigs/sdof_jenkins.toml --freq-hz 30 --floquet -o $(VENV)/warmup > /dev/null 2>&1
 	touch $(STAMP)
 
