@@ -101,7 +101,7 @@ def from_rest(name, case, res, freqs, steps):
     path at that frequency with the nearest amplitude) must not be called unstable.  A
     condensed case is integrated on the model its balance solves (kept modes + residual
     flexibility)."""
-    from hbm.timedomain.floquet_check import time_model
+    from hbm.timedomain.condensed_twin import time_model
     from hbm.timedomain.timesim import TimeSimOptions, steady_state
     out = next(iter(case.analysis.outputs))
     f, a = res.freq_hz, res.outputs[out].h1

@@ -150,9 +150,12 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
     return problem, info
 
 
-def condensed_time_model(case: Case):
+def condensed_time_model(case: Case, basis: FourierBasis | None = None, transform: str | None = None,
+                         fmax_hz: float | None = None):
     """The model the condensed solver's balance of ``case`` solves (kept modes and residual
-    flexibility) as the time integrator steps it (:mod:`hbm.timedomain.condensed_twin`).
+    flexibility) as the time integrator steps it (:mod:`hbm.timedomain.condensed_twin`), for
+    the harmonics ``basis`` up to ``fmax_hz`` (default: the case's settings; they decide the
+    modes kept).
 
     Raises
     ------
@@ -160,16 +163,18 @@ def condensed_time_model(case: Case):
         The case is solved on the full model, or a law reads velocities (the twin's static
         coordinates have none).
     """
-    from hbm.timedomain.floquet_check import time_model
+    from hbm.timedomain.condensed_twin import time_model
     from hbm.timedomain.time_parts import pack_elements
     if choose_solver(case) != "condensed":
         raise CaseError(f"{case.path}: --condensed integrates the condensed solver's model, but this case is "
                         f"solved on its full model (set [model] solver = \"condensed\")")
-    h, N, lo, hi, tr = resolve_settings(case)
-    model, _ = time_model(case, build_problem(case, FourierBasis(h, N), tr, hi)[0])
+    if basis is None:
+        h, N, _, fmax_hz, transform = resolve_settings(case)
+        basis = FourierBasis(h, N)
+    model, _ = time_model(case, build_problem(case, basis, transform, fmax_hz)[0])
     if np.any(pack_elements(model.elements, model.n_dof).laws[6]):
-        raise CaseError(f"{case.path}: --condensed cannot integrate a velocity-dependent law "
-                        f"(the residual flexibility's coordinates have no velocity)")
+        raise CaseError(f"{case.path}: a condensed model with a velocity-dependent law is not integrated in "
+                        f"time (the residual flexibility's coordinates have no velocity)")
     return model
 
 

@@ -9,8 +9,9 @@ more continuation cannot help, but the time integration can: :func:`fill_untrace
 steady-state time simulation (:func:`hbm.timedomain.timesim.timesim`, Newmark with located
 switches and an ``n`` / ``2 n`` error estimate) at points spread over the untraced stretches,
 within a time budget.  A condensed model is simulated on the model its balance solves, the
-kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`).  The points are kept apart from the HBM path (``settings["time_fill"]``,
-``frf_timedomain.csv``, markers in ``frf.png``): they carry no harmonic coefficients.
+kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`).  The points are
+kept apart from the HBM path (``settings["time_fill"]``, ``frf_timedomain.csv``, markers in
+``frf.png``): they carry no harmonic coefficients.
 
 The same simulations check the traced points estimated more than ``UNRELIABLE`` off (up to a
 third of the points when there are some): each such point's record holds the HBM's first
@@ -184,21 +185,17 @@ def _compare(p: dict, res, i: int, estimate: float) -> dict:
 def _time_model(case, res):
     """What the time simulations step: ``case`` for the full solver; for the condensed one its
     kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`), the model its
-    balance solves, unless a law reads velocities (the static coordinates have none)."""
-    from hbm.analyses.problem_setup import build_problem, choose_solver
-    from hbm.timedomain.floquet_check import time_model
-    from hbm.timedomain.time_parts import pack_elements
+    balance solves; None (and ``settings["time_fill_note"]``) when it cannot be stepped."""
+    from hbm.analyses.problem_setup import choose_solver, condensed_time_model
+    from hbm.interface.case import CaseError
     if choose_solver(case) == "full":
         return case
-    problem, _ = build_problem(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])
-    model, _ = time_model(case, problem)
-    if np.any(pack_elements(model.elements, model.n_dof).laws[6]):
-        res.settings["time_fill_note"] = (
-            "no time-domain points where the path stopped, left gaps or is far off: a condensed model with a "
-            "velocity-dependent law is not integrated in time here (hbm timesim CASE --freq-hz F integrates "
-            "its full model at one frequency)")
+    try:
+        return condensed_time_model(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])
+    except CaseError as exc:
+        res.settings["time_fill_note"] = (f"no time-domain points where the path stopped, left gaps or is far "
+                                          f"off: {str(exc).split(': ', 1)[-1]}")
         return None
-    return model
 
 
 def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = MAX_POINTS,

@@ -142,3 +142,19 @@ def twin_coefficients(linear, twin: TimeTwin, X: np.ndarray, w: float) -> np.nda
     eta = linear.modal_coefficients(X, w)
     phi_c = twin.B[:, :twin.n_modes]
     return np.hstack([eta, (X - eta @ phi_c.T) @ twin.V])
+
+
+def time_model(case, problem=None):
+    """``(model, to_model)``: what the time integrator steps for the balance of ``case``, and
+    the map ``to_model(X, w)`` of a balance point's coefficients onto its coordinates.
+
+    For the full solver that is ``case`` itself (``X`` over every DOF); for a condensed
+    ``problem`` (:class:`hbm.balance.residual.HarmonicBalance` on a condensed linear part) its
+    kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`), ``X`` being
+    the contact coordinates.
+    """
+    linear = getattr(problem, "linear", None)
+    if linear is None or not hasattr(linear, "condensed"):
+        return case, lambda X, w: X
+    twin = time_twin(linear, case.name, case.path, list(case.analysis.outputs))
+    return twin, lambda X, w: twin_coefficients(linear, twin, X, w)

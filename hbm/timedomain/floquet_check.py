@@ -22,7 +22,7 @@ import numpy as np
 from elements.kernels import law_init, law_step
 
 from hbm.balance.fourier import FourierBasis, basis_matrix
-from hbm.timedomain.condensed_twin import time_twin, twin_coefficients
+from hbm.timedomain.condensed_twin import time_model
 from hbm.timedomain.shooting import floquet_verdict, set_state, shoot
 from hbm.timedomain.time_parts import pack_elements
 from hbm.timedomain.time_results import TimeSimOptions
@@ -90,22 +90,6 @@ def start_state(packed, basis: FourierBasis, X: np.ndarray, w: float, steps: int
     v0 = w * (basis.dE[0] @ X)
     a0 = w * w * (basis.E[0] @ (basis.D @ (basis.D @ X)))
     return np.concatenate([q0, v0, a0, S])
-
-
-def time_model(case, problem=None):
-    """``(model, to_model)``: what the time integrator steps for the balance of ``case``, and
-    the map ``to_model(X, w)`` of a balance point's coefficients onto its coordinates.
-
-    For the full solver that is ``case`` itself (``X`` over every DOF); for a condensed
-    ``problem`` (:class:`hbm.balance.residual.HarmonicBalance` on a condensed linear part) its
-    kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`), ``X`` being
-    the contact coordinates.
-    """
-    linear = getattr(problem, "linear", None)
-    if linear is None or not hasattr(linear, "condensed"):
-        return case, lambda X, w: X
-    twin = time_twin(linear, case.name, case.path, list(case.analysis.outputs))
-    return twin, lambda X, w: twin_coefficients(linear, twin, X, w)
 
 
 VERDICT_TOL = 1e-5    # periodicity (relative to max |q|) that is enough to read the multipliers
