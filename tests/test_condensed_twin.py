@@ -203,6 +203,10 @@ def test_timesim_cli_integrates_the_condensed_model(tmp_path, capsys):
     K = light_contacts("full", force_dof=4).structure.K
     rows = ", ".join("[" + ", ".join(f"{v:g}" for v in r) + "]" for r in K)
     text = f"""
+element = [{{ type = "jenkins", dofs = [2], kt = 0.6, slip_force = 0.1 }},
+           {{ type = "jenkins", dofs = [3], kt = 0.4, slip_force = 0.08 }}]
+excitation = {{ dofs = [4], amplitude = [0.3] }}
+analysis = {{ harmonics = 5, frequency_hz = [0.06, 0.25], outputs = {{ x = 1, c = 4 }} }}
 [model]
 mass = [1.0, 1.0, 1e-4, 1e-4, 1e-4]
 stiffness = [{rows}]
@@ -210,23 +214,6 @@ modal_damping = 0.01
 solver = "SOLVER"
 modes = 2
 residual_flexibility = true
-[[element]]
-type = "jenkins"
-dofs = [2]
-kt = 0.6
-slip_force = 0.1
-[[element]]
-type = "jenkins"
-dofs = [3]
-kt = 0.4
-slip_force = 0.08
-[excitation]
-dofs = [4]
-amplitude = [0.3]
-[analysis]
-harmonics = 5
-frequency_hz = [0.06, 0.25]
-outputs = {{ x = 1, c = 4 }}
 """
     for solver in ("condensed", "full"):
         (tmp_path / f"{solver}.toml").write_text(text.replace("SOLVER", solver))

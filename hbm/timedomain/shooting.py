@@ -120,12 +120,14 @@ class Balance:
 
     ``a_f = M_ff^{-1}(F_c - C v - K q - G^T P S - M_fs a_s)_f`` on the free DOFs, ``a_s =
     -w^2 y_b`` on the supports; ``da/d[q, v, S]`` (n, 2 n + n_S) is zero on support rows.
-    Static DOFs (:func:`static_dofs`) have no acceleration: zero, like their rows of ``J``.
+    Static DOFs (:func:`static_dofs`, flags ``static``) have no acceleration: zero, like their
+    rows of ``J``.
     """
 
     def __init__(self, model, laws, w):
         M, C, K, F2, fixed, ybase = model
-        self.fr = np.flatnonzero((fixed == 0) & ~static_dofs(model))
+        self.static = static_dofs(model)
+        self.fr = np.flatnonzero((fixed == 0) & ~self.static)
         self.fx = np.flatnonzero(fixed)
         self.M, self.C, self.K, self.F0 = M, C, K, F2[0]
         self.a_fixed = -w * w * ybase[self.fx]
@@ -215,7 +217,6 @@ def shoot(one_period, state, model, laws, w: float, tol: float,
     """
     n = model[0].shape[0]
     n_s = state.S.size
-    static = static_dofs(model)
     balance = Balance(model, laws, w)
     residuals = []
     best = None                  # (residual, r, Newton step) of the best point so far
@@ -224,7 +225,7 @@ def shoot(one_period, state, model, laws, w: float, tol: float,
     _set_reduced(state, _reduced(state_vector(state), n), laws, balance, n)
     for it in range(1, max_iter + 1):
         r0 = _reduced(state_vector(state), n)
-        Y = start_sensitivity(n, n_s, model[4], static)
+        Y = start_sensitivity(n, n_s, model[4], balance.static)
         q_hist = one_period(state, Y)
         r1 = _reduced(state_vector(state), n)
         Yr = reduced_monodromy(Y, balance, n)

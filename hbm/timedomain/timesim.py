@@ -82,8 +82,7 @@ from hbm.analyses.budget import MEMORY_SHARE, machine_memory
 from hbm.interface.case import Case, CaseError
 from hbm.timedomain.time_march import march
 from hbm.timedomain.time_parts import pack_elements
-from hbm.timedomain.shooting import (MAX_NEWTON, Balance, floquet_verdict, reduced_monodromy, shoot, start_sensitivity,
-                                      static_dofs)
+from hbm.timedomain.shooting import MAX_NEWTON, Balance, floquet_verdict, reduced_monodromy, shoot, start_sensitivity
 from hbm.timedomain.time_results import History, Run, TimeSimOptions, TimeSimResult, output_series
 from hbm.timedomain.time_state import TimeState, kernel_model
 
@@ -247,9 +246,9 @@ def floquet(case: Case, freq_hz: float, state, options: TimeSimOptions, steps: i
     (one period with sensitivities, :mod:`hbm.timedomain.shooting`); ``state`` is advanced a period."""
     packed = pack_elements(case.elements, case.n_dof)
     model = kernel_model(case)
-    Y = start_sensitivity(case.n_dof, state.S.size, model[4], static_dofs(model))
-    _one_period(case, freq_hz, options, steps, packed)(state, Y)
     balance = Balance(model, packed.laws, 2 * np.pi * freq_hz)
+    Y = start_sensitivity(case.n_dof, state.S.size, model[4], balance.static)
+    _one_period(case, freq_hz, options, steps, packed)(state, Y)
     mu = np.linalg.eigvals(reduced_monodromy(Y, balance, case.n_dof))
     stable, big = floquet_verdict(mu)
     return stable, big, mu
