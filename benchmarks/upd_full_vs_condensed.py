@@ -10,7 +10,8 @@ DOFs.  Measured, in one run:
   first harmonic, relative difference (same model: round-off);
 * Hill's verdicts at every point of the full FRF, each point mapped onto the contact
   coordinates and judged by the condensed problem, against the full problem's;
-* the two FRFs as ``hbm.frf`` traces them: status, points, highest tip amplitude.
+* the two FRFs as ``hbm.frf`` traces them: status, points, highest tip amplitude, and the
+  peaks' relative difference.
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/upd_full_vs_condensed.py
 """
@@ -84,6 +85,9 @@ def main():
               f"{int((~res.stable).sum())} unstable, highest tip1 {a.max():.5e} at {res.freq_hz[a.argmax()]:.4f} Hz"
               + (f"; gaps: {res.settings['gap_warning'][:160]}" if res.settings.get("gap_warning") else ""))
     same_verdicts(full, cond, out["full"])
+    peaks = [(r.outputs["tip1"].h1.max(), r.freq_hz[r.outputs["tip1"].h1.argmax()]) for r in out.values()]
+    print(f"  peaks: tip1 amplitude {peaks[1][0] / peaks[0][0] - 1:+.1e} relative, frequency "
+          f"{peaks[1][1] / peaks[0][1] - 1:+.1e} relative (condensed against full; target 1e-3)")
 
 
 if __name__ == "__main__":

@@ -189,10 +189,21 @@ def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
     (the stuck one alone where the free system leaves the DOF at rest).  "Stuck" adds every
     element's tangent at rest: ``linear_stiffness`` and, for velocity laws, ``linear_damping``.
 
+    A coordinate without any linear response takes the largest scale of the model, the
+    coordinates the unknowns do not hold included (a condensed model's excitation and
+    outputs), so that full and condensed models weigh it alike.  Such a coordinate moves
+    only through the elements; where they all slip its mean is held by little more than
+    anchor springs (a damper's out-of-plane position): Newton leaves it anywhere within
+    ``tol / k_anchor``, and a small scale would turn that wander into step rejections.
+
     The linear responses include the supports' imposed motion (base excitation).
     """
     ws = np.linspace(w_lo, w_hi, 41)
-    amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, problem.stuck_stiffness(), problem.stuck_damping())
+    n = problem.n_unknowns // problem.basis.n_coef
+    amp_free, amp_stuck = problem.linear_peak_amplitudes(ws, problem.stuck_stiffness(), problem.stuck_damping(),
+                                                         observed=True)
+    s_all = np.sqrt(amp_free * amp_stuck)
+    amp_free, amp_stuck = amp_free[:n], amp_stuck[:n]
     # a DOF that only the elements couple to the force (free response nil) takes its stuck
     # amplitude, and one without any linear response (round-off) the largest scale: a
     # geometric mean with nil or the 1e-6 floor inflates it in the arclength (the path creeps)
@@ -200,8 +211,9 @@ def _unknown_scale(problem, case: Case, w_lo: float, w_hi: float) -> np.ndarray:
     nil = 1e-9 * top if top > 0 else 1.0
     af, ast = amp_free > nil, amp_stuck > nil
     s = np.where(af & ast, np.sqrt(amp_free * amp_stuck), np.where(af, amp_free, amp_stuck))
-    smax = s.max() if s.max() > 0 else 1.0
-    s = np.where(af | ast, np.maximum(s, SCALE_FLOOR * smax), smax)
+    smax = max(s.max(), s_all.max())
+    smax = smax if smax > 0 else 1.0
+    s = np.where(af | ast, np.maximum(s, SCALE_FLOOR * s.max()), smax)
     return np.tile(s, problem.basis.n_coef)
 
 

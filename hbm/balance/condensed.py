@@ -260,28 +260,30 @@ class CondensedLinear:
             u[i] = np.linalg.solve(Z[i], f[i])
         return self._real(u)
 
-    def linear_peak_amplitudes(self, ws, Ks, Cs=None):
+    def linear_peak_amplitudes(self, ws, Ks, Cs=None, observed: bool = False):
         """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear
         responses (stuck: ``Z_c + Ks``, (n_c, n_c)).
 
-        ``Cs`` is not used (the stuck limit adds the stiffness only).
+        ``Cs`` is not used (the stuck limit adds the stiffness only).  ``observed`` appends the
+        excitation and output coordinates (their stuck response: ``y = H_ae F_e - H_ac Ks U``).
 
         Returns
         -------
-        free, stuck : ndarray, shape (n_c,)
+        free, stuck : ndarray, shape (n_c,), or (n_c + n_e + n_o,) when ``observed``
         """
         ws = np.atleast_1d(np.asarray(ws, dtype=float))
-        nc = self.n_dof
-        free, stuck = np.zeros(nc), np.zeros(nc)
+        nc, ne = self.n_dof, self._Fe_c.shape[1]
+        rows = np.arange(self._sl["o"].stop if observed else nc)
+        free, stuck = np.zeros(rows.size), np.zeros(rows.size)
         for w in ws:               # one frequency at a time: n_c^2 memory, not n_w n_c^2
-            ne = self._Fe_c.shape[1]
-            H = self._builder.receptances(np.array([w]), np.arange(nc), np.arange(nc + ne))[0]
-            u = H[:, nc:] @ self._Fe_c[self._i1]               # (n_c,) contact response to F_e
+            H = self._builder.receptances(np.array([w]), rows, np.arange(nc + ne))[0]
+            u = H[:, nc:] @ self._Fe_c[self._i1]               # response to F_e
             free = np.maximum(free, np.abs(u))
             try:
-                stuck = np.maximum(stuck, np.abs(np.linalg.solve(np.eye(nc) + H[:, :nc] @ Ks, u)))
+                uc = np.linalg.solve(np.eye(nc) + H[:nc, :nc] @ Ks, u[:nc])
             except np.linalg.LinAlgError:                      # skip a singular frequency
-                pass
+                continue
+            stuck = np.maximum(stuck, np.abs(np.r_[uc, u[nc:] - H[nc:, :nc] @ (Ks @ uc)]))
         return free, stuck
 
     # ------------------------------------------------------------------ outputs and energy

@@ -203,9 +203,10 @@ class DenseLinear:
         """Output coefficients ``X G_o^T`` (n_coef, n_o) of a point ``X`` (n_coef, n)."""
         return X @ self.output_rows.T
 
-    def linear_peak_amplitudes(self, ws, Ks, Cs=None):
+    def linear_peak_amplitudes(self, ws, Ks, Cs=None, observed: bool = False):
         """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear
         responses (stuck: ``K + Ks``, ``C + Cs``), supports' imposed motion included.
+        ``observed`` adds nothing: the excitation and the outputs are combinations of the DOFs.
 
         Returns
         -------

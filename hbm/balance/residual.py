@@ -227,10 +227,12 @@ class HarmonicBalance:
         """Solution of ``(Z(w) + K_extra) X = F(w)`` (n_coef, n): the start of Newton."""
         return self.linear.linear_solution(w, extra_stiffness)
 
-    def linear_peak_amplitudes(self, ws, stuck_stiffness, stuck_damping=None):
+    def linear_peak_amplitudes(self, ws, stuck_stiffness, stuck_damping=None, observed=False):
         """Largest first-harmonic amplitudes over ``ws`` of the free and the stuck linear
-        responses, (n_free,) each (:meth:`stuck_stiffness`, :meth:`stuck_damping`)."""
-        return self.linear.linear_peak_amplitudes(ws, stuck_stiffness, stuck_damping)
+        responses, (n_free,) each (:meth:`stuck_stiffness`, :meth:`stuck_damping`); with
+        ``observed``, followed by those of coordinates the unknowns do not hold (a condensed
+        model's excitation and outputs)."""
+        return self.linear.linear_peak_amplitudes(ws, stuck_stiffness, stuck_damping, observed)
 
     def load(self, w: float) -> np.ndarray:
         """The load ``F(w)`` (n_coef, n) the linear part balances."""
