@@ -244,7 +244,7 @@ def test_runs_of_unstable_points_are_confirmed_by_their_middle(monkeypatch):
 
     def fake(case, basis, X, f, steps, problem):
         asked.append(f)
-        return fc.FloquetCheck(f in truly_stable, 1.0, True, 0.0, "")
+        return fc.FloquetCheck(f in truly_stable, 1.0, True, 0.0, "", {}, {}, 1)
     monkeypatch.setattr(fc, "check_point", fake)
     Xs = np.zeros((20, 3, case.n_dof))
     st = {}

@@ -74,7 +74,7 @@ def test_a_stop_short_of_the_window_is_answered_by_time_simulations(stopped, tmp
     (a, b), = untraced_stretches(res)
     assert a == 0.086 and 0.09 < b < 0.11
     # 3 points: 2 in the stretch (0.086 Hz settles in 39 periods), 1 check of the traced point
-    # next to the stop (estimated 62 % off; settles in 77 periods)
+    # next to the stop (estimated 62 % off; from rest it settles in 77 periods)
     rec = fill_untraced(case, res, budget=20.0, max_points=3)
     assert res.settings["time_fill"] is rec and rec["skipped"] == []
     untraced = [p for p in rec["points"] if p["kind"] == "untraced"]
@@ -90,9 +90,16 @@ def test_a_stop_short_of_the_window_is_answered_by_time_simulations(stopped, tmp
     assert check["hbm_h1"]["x"] == res.outputs["x"].h1[i]
     assert check["ok"] and check["hbm_off"] == pytest.approx(abs(res.outputs["x"].h1[i] / check["h1"]["x"] - 1))
     assert 0.05 < check["hbm_off"] < check["hbm_estimate"]     # off indeed, within its estimate
+    # shot from the traced point: the periodic solution a simulation from rest settles on
+    # (1.8e-7 apart), in 8 periods instead of 77, with its Floquet verdict
+    rest = hbm.timesim(case, check["freq_hz"])
+    assert check["method"] == "shooting" and check["stable"] and check["periods"] < rest.periods / 4
+    assert check["h1"]["x"] == pytest.approx(rest.h1["x"], rel=1e-5)
+    assert check["error_estimate"] == pytest.approx(rest.error_estimate, rel=0.05)
     (f_near, e_near), = rec["stretches"][0]["neighbour_errors"]
     assert f_near == pytest.approx(b) and e_near > 0.3
     assert "estimated" in rec["note"] and "H = 15" in rec["note"] and "1 traced point estimated" in rec["note"]
+    assert "1 shot from the traced point" in rec["note"]
     write_frf(case, res, tmp_path)
     rows = list(csv.DictReader(open(tmp_path / "frf_timedomain.csv")))
     assert [float(r["freq_hz"]) for r in rows] == pytest.approx([q["freq_hz"] for q in rec["points"]])

@@ -15,7 +15,13 @@ kept apart from the HBM path (``settings["time_fill"]``, ``frf_timedomain.csv``,
 
 The same simulations check the traced points estimated more than ``UNRELIABLE`` off (up to a
 third of the points when there are some): each such point's record holds the HBM's first
-harmonics beside the time domain's, and how far apart they are.
+harmonics beside the time domain's, and how far apart they are.  A check shoots from the
+traced point itself (:func:`hbm.timedomain.floquet_check.check_point`: Newton on the period
+map, ``n`` and ``2 n`` steps per period for the error estimate), so it finds the periodic
+solution of the same branch in a few periods, with its Floquet verdict; a lightly damped
+rig integrated from rest may take thousands of periods (the UPD flanks rig: not periodic
+after 224 periods in 7.5 s) or settle on another branch.  Where shooting does not converge
+(a non-smooth period map near a fold), the check is integrated from rest instead.
 
 A stretch is ``[a, b]`` with ``a`` and ``b`` the ends of the traced spans around it (or the
 window's ends); its points sit at the window's end when the stretch reaches it, else at
@@ -171,6 +177,32 @@ def wanted(res) -> bool:
             or (worst is not None and bool(np.nanmax(worst) > UNRELIABLE)))
 
 
+def _shoot(case, res, problem, i: int) -> dict | None:
+    """The check of path point ``i`` by shooting from it (module doc) as a record like
+    :func:`_simulate`'s, with ``method``, ``stable`` and ``largest_multiplier``; None when
+    shooting cannot be used (support excitation, a velocity law) or does not converge."""
+    from hbm.timedomain.floquet_check import check_point
+    from hbm.timedomain.time_results import TimeSimOptions
+    t0, f, n = time.perf_counter(), float(res.freq_hz[i]), TimeSimOptions().steps
+    runs = []
+    for steps in (n, 2 * n):
+        try:
+            c = check_point(case, res.basis, res.X[i], f, steps=steps, problem=problem)
+        except ValueError:
+            return None
+        if not c.converged:
+            return None
+        runs.append(c)
+    coarse, fine = runs
+    est = max(abs(a[k] - b[k]) / abs(b[k]) for a, b in ((coarse.h1, fine.h1), (coarse.max, fine.max))
+              for k in b if b[k] != 0.0)
+    return {"freq_hz": f, "ok": True, "h1": fine.h1, "max": fine.max, "error_estimate": float(est),
+            "periods": coarse.periods + fine.periods, "seconds": time.perf_counter() - t0,
+            "message": (f"shot from the traced point; Floquet: {'stable' if fine.stable else 'unstable'} "
+                        f"(largest |multiplier| {fine.largest:.4g})"),
+            "method": "shooting", "stable": bool(fine.stable), "largest_multiplier": float(fine.largest)}
+
+
 def _compare(p: dict, res, i: int, estimate: float) -> dict:
     """A time-domain point at path point ``i`` (estimated ``estimate`` off), with the HBM's
     first harmonics beside it."""
@@ -196,6 +228,19 @@ def _time_model(case, res):
         res.settings["time_fill_note"] = (f"no time-domain points where the path stopped, left gaps or is far "
                                           f"off: {str(exc).split(': ', 1)[-1]}")
         return None
+
+
+def _problem_once(case, res):
+    """``problem()``: the FRF's balance problem, built on the first call (the checks shoot from
+    its points; a condensed model's reduction comes from its cache)."""
+    built = []
+
+    def problem():
+        if not built:
+            from hbm.analyses.problem_setup import build_problem
+            built.append(build_problem(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])[0])
+        return built[0]
+    return problem
 
 
 def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = MAX_POINTS,
@@ -238,6 +283,7 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     todo += [(float(res.freq_hz[i]), i) for i in check_points(res, max_points - len(todo), worst)]
     if not todo:
         return None
+    problem = _problem_once(case, res)
     t0, points, skipped = time.perf_counter(), [], []
     for k in spread_order(len(todo)):
         f, i = todo[k]
@@ -247,7 +293,8 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
             continue
         share = POINT_SHARE * budget
         why = "a point's share of the budget" if share < left else "the budget ran out"
-        p = {"kind": "untraced", **_simulate(model, f, min(left, share), why)}
+        shot = None if i is None else _shoot(case, res, problem(), i)
+        p = {"kind": "untraced", **(shot or _simulate(model, f, min(left, share), why))}
         points.append(p if i is None else _compare(p, res, i, worst[i]))
         if progress is not None:
             progress(len(points), len(todo))
@@ -278,6 +325,11 @@ def fill_note(record: dict, harmonics) -> str:
     if off:
         span = f"{100 * min(off):.2g}" + ("" if len(off) == 1 else f"-{100 * max(off):.2g}")
         note += f"; there the HBM's first harmonic is off by {span} %"
+        shot = [p for p in checks if p.get("method") == "shooting"]
+        if shot:
+            unstable = sum(not p["stable"] for p in shot)
+            note += (f" ({len(shot)} shot from the traced point"
+                     + (f", {unstable} of them unstable by Floquet" if unstable else "") + ")")
     bad = [p for p in record["points"] if not p["ok"]]
     if bad:
         note += f"; at {bad[0]['freq_hz']:.6g} Hz {bad[0]['message']}"

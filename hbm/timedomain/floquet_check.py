@@ -25,7 +25,7 @@ from hbm.balance.fourier import FourierBasis, basis_matrix
 from hbm.timedomain.condensed_twin import time_model
 from hbm.timedomain.shooting import floquet_verdict, set_state, shoot
 from hbm.timedomain.time_parts import pack_elements
-from hbm.timedomain.time_results import TimeSimOptions
+from hbm.timedomain.time_results import TimeSimOptions, period_amplitudes
 
 
 @dataclass(frozen=True)
@@ -44,6 +44,11 @@ class FloquetCheck:
         ``max|q_time - q_balance|`` over the period, relative to ``max|q_balance|``: how far
         the time solution is from the balance point (same branch if small).
     message : str
+    h1, max : dict
+        Per case output, the time solution's first-harmonic amplitude and largest ``|y|``
+        over its last period (:func:`hbm.timedomain.time_results.period_amplitudes`).
+    periods : int
+        Periods integrated.
     """
 
     stable: bool
@@ -51,6 +56,9 @@ class FloquetCheck:
     converged: bool
     distance: float
     message: str
+    h1: dict
+    max: dict
+    periods: int
 
 
 def _start_states(packed, G_all_q: np.ndarray):
@@ -134,10 +142,11 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
     theta = 2.0 * np.pi * np.arange(steps + 1) / steps
     q_hb = basis_matrix(basis.h_of_row, theta) @ Xm
     q_td = periods[-1]
+    h1, mx = period_amplitudes(model, q_td, theta / w, w)
     if model is not case:           # compare the contact motion u = B y
         q_hb, q_td = q_hb @ model.B.T, q_td @ model.B.T
     dist = float(np.abs(q_td - q_hb).max() / max(np.abs(q_hb).max(), 1e-300))
-    return FloquetCheck(stable, big, shot.converged, dist, shot.message)
+    return FloquetCheck(stable, big, shot.converged, dist, shot.message, h1, mx, len(periods))
 
 
 MAX_CONFIRM = 40            # Hill-unstable points checked per FRF at most

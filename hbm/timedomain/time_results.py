@@ -176,3 +176,17 @@ def output_series(case, q: np.ndarray, t: np.ndarray, w: float) -> dict:
             y = y + feed[name][0] * np.cos(w * t) + feed[name][1] * np.sin(w * t)
         out[name] = y
     return out
+
+
+def period_amplitudes(case, q: np.ndarray, t: np.ndarray, w: float):
+    """``(h1, max)`` per output of one period sampled at ``N + 1`` rows ``q`` (N + 1, n) and
+    times ``t`` (N + 1,) from its start to its end: ``h1 = sqrt(a^2 + b^2)`` with
+    ``a, b = 2/N sum y_j (cos, sin)(2 pi j / N)`` over samples ``1 .. N`` and ``max = max |y_j|``."""
+    N = q.shape[0] - 1
+    th = 2.0 * np.pi * np.arange(1, N + 1) / N
+    h1, mx = {}, {}
+    for name, xo in output_series(case, q, t, w).items():
+        x = xo[1:]
+        h1[name] = float(np.hypot(2.0 / N * np.dot(x, np.cos(th)), 2.0 / N * np.dot(x, np.sin(th))))
+        mx[name] = float(np.abs(xo).max())
+    return h1, mx

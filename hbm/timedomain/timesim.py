@@ -83,7 +83,7 @@ from hbm.interface.case import Case, CaseError
 from hbm.timedomain.time_march import march
 from hbm.timedomain.time_parts import pack_elements
 from hbm.timedomain.shooting import MAX_NEWTON, Balance, floquet_verdict, reduced_monodromy, shoot, start_sensitivity
-from hbm.timedomain.time_results import History, Run, TimeSimOptions, TimeSimResult, output_series
+from hbm.timedomain.time_results import History, Run, TimeSimOptions, TimeSimResult, period_amplitudes
 from hbm.timedomain.time_state import TimeState, kernel_model
 
 __all__ = ["History", "Run", "TimeSimOptions", "TimeSimResult", "steady_state", "timesim", "transient"]
@@ -113,15 +113,7 @@ def _check_freq(freq_hz):
 
 def _amplitudes(case: Case, hist: History, N: int, w: float):
     """``h1`` and ``max`` per output over the last ``N + 1`` rows (one period)."""
-    th = 2.0 * np.pi * np.arange(1, N + 1) / N
-    h1, mx = {}, {}
-    for name, xo in output_series(case, hist.q[-(N + 1):], hist.t[-(N + 1):], w).items():
-        x = xo[1:]
-        a = 2.0 / N * np.dot(x, np.cos(th))
-        b = 2.0 / N * np.dot(x, np.sin(th))
-        h1[name] = float(np.hypot(a, b))
-        mx[name] = float(np.abs(xo).max())
-    return h1, mx
+    return period_amplitudes(case, hist.q[-(N + 1):], hist.t[-(N + 1):], w)
 
 
 _NO_SENS = np.zeros((0, 0))
