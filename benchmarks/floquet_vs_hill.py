@@ -15,7 +15,8 @@ The condensed cases (``upd_like``, ``upd_rig_flanks``) are checked on the model 
 balance solves, its kept modes and residual flexibility in the time domain
 (:mod:`hbm.timedomain.condensed_twin`).
 
-Writes benchmarks/results/floquet_vs_hill.csv and prints the agreement per case; then runs
+Writes benchmarks/results/floquet_vs_hill.csv (the rows of the cases run; an earlier run's
+rows of the other cases are kept) and prints the agreement per case; then runs
 the time integration from rest at a few frequencies and checks that the FRF point it settles
 on is not called unstable.
 """
@@ -146,9 +147,14 @@ def main(argv=None):
         bad += from_rest(name, case, res, REST.get(name, ()), args.steps)
     out = ROOT / "benchmarks" / "results" / "floquet_vs_hill.csv"
     out.parent.mkdir(exist_ok=True)
+    run = {r["case"] for r in rows}
+    kept = [r for r in csv.DictReader(open(out))] if out.exists() else []
+    kept = [r for r in kept if r["case"] not in run]       # the other cases' rows of an earlier run
     with open(out, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
+        for r in kept:
+            w.writerow(r)
         for r in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
     conv = [r for r in rows if r["converged"]]

@@ -60,3 +60,21 @@ def test_modes_above_the_harmonics_enter_statically():
     assert every.max_real > 0.5 * w
     res = hill_stability(*hs(X, w), hs.basis, w)
     assert res.stable and -1e-3 * w < res.max_real < 0
+
+
+def test_modes_above_h_plus_a_half_have_no_kept_exponent():
+    # UPD-like rig at 263.16 Hz (H = 3): with the modes up to (2H + 1/2) w dynamic, Hill finds
+    # an exponent of +1.4e-3 w; the modes between (H + 1/2) w and (2H + 1/2) w have no member
+    # of their family in the strip within the retained harmonics, and without them (the
+    # default cut-off) the point is stable, as the period map's multipliers say
+    from hbm.timedomain.floquet_check import check_point
+    f = 263.159463
+    case = hbm.load_case(ROOT / "benchmarks/upd_like.toml")
+    X, basis, problem = solve_at(case, f)
+    w = 2 * np.pi * f
+    J_nl = problem.nonlinear_jacobian(X, w)
+    wide = hill_stability(*modal_hill_system(problem.modal_data(), J_nl, basis, w, cutoff=6.5 * w), basis, w)
+    assert not wide.stable and wide.max_real > 1e-3 * w
+    assert point_stability(problem, X, w).stable
+    floquet = check_point(case, basis, X, f, steps=256, problem=problem)
+    assert floquet.converged and floquet.stable

@@ -94,7 +94,7 @@ def point_is_stable(problem, X: np.ndarray, w: float, options: StabilityOptions 
 
 def point_stability(problem, X: np.ndarray, w: float, options: StabilityOptions | None = None) -> HillResult:
     """:func:`hill_stability` of the point ``X`` (n_coef, n) of a harmonic-balance problem, on
-    its modal Hill system (:class:`HillSystem`): the modes at or below ``(2 H + 1/2) w`` of the
+    its modal Hill system (:class:`HillSystem`): the modes at or below ``max(H + 1/2, 5/2) w`` of the
     free DOFs (supports with imposed motion are not perturbed) or of a condensed model."""
     hs = HillSystem(problem)
     return hill_stability(*hs(X, w), hs.basis, w, options)
