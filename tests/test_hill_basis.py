@@ -78,3 +78,28 @@ def test_modes_above_h_plus_a_half_have_no_kept_exponent():
     assert point_stability(problem, X, w).stable
     floquet = check_point(case, basis, X, f, steps=256, problem=problem)
     assert floquet.converged and floquet.stable
+
+
+def test_every_mode_dynamic_takes_the_direct_product_and_lapack_eigenvalues():
+    # a full model keeps every mode dynamic here (no static flexibility): the modal Hill
+    # Jacobian is Phi^T J_nl Phi directly, the same as through the stuck-stiffness solve
+    import scipy.linalg as sla
+    from hbm.analyses.modal_hill import _element_response
+    from hbm.analyses.stability_path import eigenvalues
+    from hbm.model.linear import fill_dynamic_stiffness
+    case = blade_couple(list(range(10)))
+    X, basis, problem = solve_at(case, 119.9)
+    hs = HillSystem(problem)
+    w = 2 * np.pi * 119.9
+    J_nl = hs.jacobian(X, w)
+    J, M, C = modal_hill_system(hs.modal, J_nl, hs.basis, w)
+    m, nco = hs.modal.phi_c.shape[1], hs.basis.n_coef
+    assert not hs.modal.R_cc.any() and J.shape == (nco * m, nco * m)
+    R = np.zeros_like(hs.modal.R_cc)
+    Y = _element_response(R, J_nl, hs.modal.phi_c, nco, hs.modal.K_ref if hs.modal.K_ref is not None else R)
+    ref = fill_dynamic_stiffness(np.zeros_like(J), np.diag(hs.modal.omega ** 2), np.ascontiguousarray(C),
+                                 np.eye(m), hs.basis, w)
+    ref += np.einsum("ca,icn->ian", hs.modal.phi_c, Y).reshape(nco * m, nco * m)
+    assert np.abs(J - ref).max() <= 1e-12 * np.abs(ref).max()
+    A = np.random.default_rng(1).normal(size=(37, 37))
+    assert np.allclose(np.sort_complex(eigenvalues(A.copy())), np.sort_complex(sla.eigvals(A)), rtol=1e-10)

@@ -151,8 +151,11 @@ def modal_hill_system(modal: ModalData, J_nl, basis, w: float, cutoff: float | N
         return J, np.eye(m), Cm
     hi = ~dyn
     R = modal.R_cc + (phi_c[:, hi] / om[hi] ** 2) @ phi_c[:, hi].T
-    Y = _element_response(R, J_nl, phi_c[:, dyn], nco,
-                          np.zeros_like(R) if modal.K_ref is None else modal.K_ref)
+    if not R.any():         # no static flexibility (every mode dynamic): K_eff = Phi_c^T J_nl Phi_c
+        Y = (J_nl @ _on_every_row(phi_c[:, dyn], nco)).reshape(nco, -1, nco * m)
+    else:
+        Y = _element_response(R, J_nl, phi_c[:, dyn], nco,
+                              np.zeros_like(R) if modal.K_ref is None else modal.K_ref)
     J += np.einsum("ca,icn->ian", phi_c[:, dyn], Y).reshape(nco * m, nco * m)   # Phi_c^T per coefficient row
     return J, np.eye(m), Cm
 
