@@ -291,9 +291,13 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         if left <= 0:
             skipped.append(f)
             continue
+        shot = None if i is None else _shoot(case, res, problem(), i)
+        left = budget - (time.perf_counter() - t0)      # a shot that did not converge took its time
         share = POINT_SHARE * budget
         why = "a point's share of the budget" if share < left else "the budget ran out"
-        shot = None if i is None else _shoot(case, res, problem(), i)
+        if shot is None and left <= 0:
+            skipped.append(f)
+            continue
         p = {"kind": "untraced", **(shot or _simulate(model, f, min(left, share), why))}
         points.append(p if i is None else _compare(p, res, i, worst[i]))
         if progress is not None:
