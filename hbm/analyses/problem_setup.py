@@ -151,11 +151,11 @@ def build_problem(case: Case, basis: FourierBasis, transform: str, fmax_hz: floa
 
 
 def condensed_time_model(case: Case, basis: FourierBasis | None = None, transform: str | None = None,
-                         fmax_hz: float | None = None):
+                         fmax_hz: float | None = None, problem=None):
     """The model the condensed solver's balance of ``case`` solves (kept modes and residual
     flexibility) as the time integrator steps it (:mod:`hbm.timedomain.condensed_twin`), for
     the harmonics ``basis`` up to ``fmax_hz`` (default: the case's settings; they decide the
-    modes kept).
+    modes kept), or of the balance ``problem`` already built for them.
 
     Raises
     ------
@@ -168,10 +168,12 @@ def condensed_time_model(case: Case, basis: FourierBasis | None = None, transfor
     if choose_solver(case) != "condensed":
         raise CaseError(f"{case.path}: --condensed integrates the condensed solver's model, but this case is "
                         f"solved on its full model (set [model] solver = \"condensed\")")
-    if basis is None:
-        h, N, _, fmax_hz, transform = resolve_settings(case)
-        basis = FourierBasis(h, N)
-    model, _ = time_model(case, build_problem(case, basis, transform, fmax_hz)[0])
+    if problem is None:
+        if basis is None:
+            h, N, _, fmax_hz, transform = resolve_settings(case)
+            basis = FourierBasis(h, N)
+        problem = build_problem(case, basis, transform, fmax_hz)[0]
+    model, _ = time_model(case, problem)
     if np.any(pack_elements(model.elements, model.n_dof).laws[6]):
         raise CaseError(f"{case.path}: a condensed model with a velocity-dependent law is not integrated in "
                         f"time (the residual flexibility's coordinates have no velocity)")

@@ -180,7 +180,8 @@ def wanted(res) -> bool:
 def _shoot(case, res, problem, i: int) -> dict | None:
     """The check of path point ``i`` by shooting from it (module doc) as a record like
     :func:`_simulate`'s, with ``method``, ``stable`` and ``largest_multiplier``; None when
-    shooting cannot be used (support excitation, a velocity law) or does not converge."""
+    shooting cannot be used (support excitation, a velocity law) or does not converge.
+    ``problem``: the condensed balance the point solves (None for a full model)."""
     from hbm.timedomain.floquet_check import check_point
     from hbm.timedomain.time_results import TimeSimOptions
     t0, f, n = time.perf_counter(), float(res.freq_hz[i]), TimeSimOptions().steps
@@ -214,33 +215,31 @@ def _compare(p: dict, res, i: int, estimate: float) -> dict:
     return p
 
 
-def _time_model(case, res):
+def _condensed_problem(case, res):
+    """The balance problem of a condensed FRF (the time model and the checks' shots come from
+    it), None for the full solver (its checks need none)."""
+    from hbm.analyses.problem_setup import build_problem, choose_solver
+    if choose_solver(case) == "full":
+        return None
+    return build_problem(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])[0]
+
+
+def _time_model(case, res, problem=None):
     """What the time simulations step: ``case`` for the full solver; for the condensed one its
     kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`), the model its
-    balance solves; None (and ``settings["time_fill_note"]``) when it cannot be stepped."""
+    balance (``problem``, built here when None) solves; None (and
+    ``settings["time_fill_note"]``) when it cannot be stepped."""
     from hbm.analyses.problem_setup import choose_solver, condensed_time_model
     from hbm.interface.case import CaseError
     if choose_solver(case) == "full":
         return case
     try:
-        return condensed_time_model(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])
+        return condensed_time_model(case, res.basis, res.settings["transform"], res.settings["fmax_hz"],
+                                    problem=problem)
     except CaseError as exc:
         res.settings["time_fill_note"] = (f"no time-domain points where the path stopped, left gaps or is far "
                                           f"off: {str(exc).split(': ', 1)[-1]}")
         return None
-
-
-def _problem_once(case, res):
-    """``problem()``: the FRF's balance problem, built on the first call (the checks shoot from
-    its points; a condensed model's reduction comes from its cache)."""
-    built = []
-
-    def problem():
-        if not built:
-            from hbm.analyses.problem_setup import build_problem
-            built.append(build_problem(case, res.basis, res.settings["transform"], res.settings["fmax_hz"])[0])
-        return built[0]
-    return problem
 
 
 def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = MAX_POINTS,
@@ -271,7 +270,8 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         nothing to simulate or the model is not simulated here (a condensed model with a
         velocity-dependent law; ``settings["time_fill_note"]`` says so).
     """
-    model = _time_model(case, res)
+    problem = _condensed_problem(case, res)
+    model = _time_model(case, res, problem)
     if model is None:
         return None
     window = (float(res.settings["fmin_hz"]), float(res.settings["fmax_hz"]))
@@ -283,7 +283,6 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     todo += [(float(res.freq_hz[i]), i) for i in check_points(res, max_points - len(todo), worst)]
     if not todo:
         return None
-    problem = _problem_once(case, res)
     t0, points, skipped = time.perf_counter(), [], []
     for k in spread_order(len(todo)):
         f, i = todo[k]
@@ -291,7 +290,7 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         if left <= 0:
             skipped.append(f)
             continue
-        shot = None if i is None else _shoot(case, res, problem(), i)
+        shot = None if i is None else _shoot(case, res, problem, i)
         left = budget - (time.perf_counter() - t0)      # a shot that did not converge took its time
         share = POINT_SHARE * budget
         why = "a point's share of the budget" if share < left else "the budget ran out"
