@@ -22,18 +22,55 @@ from __future__ import annotations
 
 import numba as nb
 import numpy as np
+from numba.core import types
+from numba.extending import overload
 
-from .laws.registry import _law_init, _law_step
+from .laws.registry import INITS, STEPS, _law_init, _law_step
 
 
 # One dispatch text, two compilations: a called kernel for the time integrator
 # (hbm.timedomain.timesim, ``kind`` varies per element), and an inlined one for the marches, where a
-# constant ``kind`` (elements.law_march.march_of) lets numba prune the other laws' branches
-# before typing, so that only the marched law is compiled, inlined into the sample loop.
+# constant ``kind`` (elements.law_march.march_of) selects the law's own step at typing time, so
+# that only the marched law is compiled, inlined into the sample loop.
 law_step = nb.njit(cache=True)(_law_step)
 law_init = nb.njit(cache=True)(_law_init)
-law_step_inline = nb.njit(inline="always")(_law_step)
-law_init_inline = nb.njit(inline="always")(_law_init)
+
+
+def law_step_inline(kind, p, s, z, s_new, A, B):
+    """:func:`law_step` inlined into compiled callers (no Python implementation)."""
+    raise NotImplementedError("called from compiled code only")
+
+
+def law_init_inline(kind, p, z0, s0, C0):
+    """:func:`law_init` inlined into compiled callers (no Python implementation)."""
+    raise NotImplementedError("called from compiled code only")
+
+
+@overload(law_step_inline, inline="always", prefer_literal=True)
+def _law_step_of(kind, p, s, z, s_new, A, B):
+    """A constant ``kind`` (a literal type) inlines that law's step alone; otherwise the
+    dispatch on ``kind``.  Selecting here, at typing, copies one law's code into the march:
+    inlining the dispatch copied every law's (pruned only afterwards), which was a third of
+    the first run's compile time."""
+    if isinstance(kind, types.IntegerLiteral):
+        step = STEPS[kind.literal_value]
+
+        def one(kind, p, s, z, s_new, A, B):
+            step(p, s, z, s_new, A, B)
+        return one
+    return _law_step
+
+
+@overload(law_init_inline, inline="always", prefer_literal=True)
+def _law_init_of(kind, p, z0, s0, C0):
+    """As :func:`_law_step_of`, for the rest state."""
+    if isinstance(kind, types.IntegerLiteral):
+        init = INITS[kind.literal_value]
+
+        def one(kind, p, z0, s0, C0):
+            init(p, z0, s0, C0)
+        return one
+    return _law_init
 
 
 @nb.njit(cache=True)
