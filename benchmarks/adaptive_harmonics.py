@@ -31,7 +31,7 @@ import hbm  # noqa: E402
 from hbm.analyses.adaptive import frf_to_tolerance, next_harmonics  # noqa: E402
 from hbm.analyses.response import solve_at  # noqa: E402
 from test_truncation import three_dof  # noqa: E402
-from time_vs_error import cpu, write_rows  # noqa: E402
+from bench_cases import cpu, write_rows  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 CASES = {

@@ -30,7 +30,7 @@ from hbm.interface.case import case_from_dict  # noqa: E402
 from elements.brush import hertz_stiffness  # noqa: E402
 from elements.hertz import hertz_contact  # noqa: E402
 from beam_damper_beam_study import CASE, LOADS, case_data, peak_in  # noqa: E402
-from time_vs_error import write_rows  # noqa: E402
+from bench_cases import write_rows  # noqa: E402
 
 RADII = (2.6e-3, 5e-3, 10e-3)
 

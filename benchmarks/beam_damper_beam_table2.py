@@ -35,7 +35,7 @@ import hbm  # noqa: E402
 from hbm.interface.case import case_from_dict  # noqa: E402
 from elements.hertz import hertz_contact  # noqa: E402
 from beam_damper_beam_study import CASE, K_BODY, case_data, peak_in  # noqa: E402
-from time_vs_error import write_rows  # noqa: E402
+from bench_cases import write_rows  # noqa: E402
 
 # N [N]: (contact length [m], k_w [N/m], seed Table 2 OoP [Hz, um], seed experiment [Hz, um])
 TABLE2 = {10.0: (1e-3, 17e6, (610, 0.13), (610, 0.29)),

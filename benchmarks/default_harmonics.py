@@ -60,7 +60,8 @@ from scipy.interpolate import PchipInterpolator
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from time_vs_error import ROOT, RESULTS, cpu, refined_peak, sdof_case, couple_case, inclined_case  # noqa: E402
+from bench_cases import ROOT, RESULTS, cpu, sdof_case, couple_case, inclined_case  # noqa: E402
+from time_vs_error import refined_peak  # noqa: E402
 
 import hbm  # noqa: E402
 from hbm.interface.case import case_from_dict  # noqa: E402

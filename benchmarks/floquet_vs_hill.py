@@ -52,7 +52,7 @@ def duffing():
 
 
 def cases():
-    from time_vs_error import target_case
+    from bench_cases import target_case
     return {
         "duffing": duffing,
         "sdof_jenkins": lambda: load_case(ROOT / "rigs" / "sdof_jenkins.toml"),

@@ -58,7 +58,7 @@ import hbm  # noqa: E402
 from hbm.analyses.response import solve_at  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from time_vs_error import write_rows  # noqa: E402
+from bench_cases import write_rows  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 K = [[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]]

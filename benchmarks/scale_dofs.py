@@ -25,7 +25,7 @@ from pathlib import Path
 from hbm.interface.case import case_from_dict
 from hbm.balance.fourier import FourierBasis
 from hbm.analyses.response import build_problem, frf
-from time_vs_error import write_rows         # benchmarks/ is the script's own folder
+from bench_cases import write_rows         # benchmarks/ is the script's own folder
 
 HERE = Path(__file__).resolve().parent
 ELEMENTS_PER_BLADE = (10, 40, 100, 400, 1000, 4000, 8000)

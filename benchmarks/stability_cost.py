@@ -26,7 +26,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import hbm                                      # noqa: E402
 from hbm.interface.case import case_from_dict, load_case  # noqa: E402
-from time_vs_error import target_case, write_rows       # noqa: E402
+from bench_cases import target_case, write_rows       # noqa: E402
 
 TARGETS = {"three_dof_two_jenkins": 0.5, "upd_rig": 1.0}
 

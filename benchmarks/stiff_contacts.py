@@ -28,7 +28,7 @@ import hbm                                      # noqa: E402
 from den_hartog import den_hartog               # noqa: E402
 from hbm.analyses.time_fill import fill_untraced, wanted  # noqa: E402
 from hbm.interface.case import case_from_dict   # noqa: E402
-from time_vs_error import write_rows            # noqa: E402
+from bench_cases import write_rows            # noqa: E402
 
 
 def jenkins_sdof(kt, H, c, aft):

@@ -21,7 +21,7 @@ from hbm.interface.case import case_from_dict
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from time_vs_error import target_case  # noqa: E402
+from bench_cases import target_case  # noqa: E402
 
 
 def hill_systems(case, every):
