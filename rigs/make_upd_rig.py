@@ -140,6 +140,74 @@ def mu_case(mu):
     return p
 
 
+def _plot_frf(plt, frf, base, st, cf):
+    """The FRF at CF/Fexc = 1e4 beside the rig without damper, the stuck modes marked."""
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.semilogy(base["freq_hz"], base["tip1_h1"] / (cf / 1e4), "k:", label="no damper")
+    ax.semilogy(frf["freq_hz"], frf["tip1_h1"] / (cf / 1e4), "-", label="damper, CF/Fexc = 1e4, mu = 0.6")
+    for f, kind in st:
+        ax.axvline(f, color="0.7", lw=0.8)
+        ax.text(f, 1e-6, f" {kind}", fontsize=8)
+    ax.set_xlabel("f (Hz)")
+    ax.set_ylabel("tip 1 receptance |x_h1| / Fexc (m/N)")
+    ax.set_title("UPD rig: IP and OoP 1F modes, one continuation")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(OUT / "frf_ip_oop.png", dpi=100)
+    plt.close(fig)
+
+
+def _plot_sweeps(plt, cf):
+    """OoP (and IP at mu = 0.6) peak receptance against the force ratio; returns its lines."""
+    lines = []
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for mu in MUS:
+        rows = sweep_receptance(OUT / f"sweep_mu{mu:g}", cf)
+        r = np.array([x for x, _ in rows])
+        oop = np.array([p["OoP"][1] for _, p in rows])
+        ip = np.array([p["IP"][1] for _, p in rows])
+        ax.loglog(r, oop, "o-", label=f"OoP, mu = {mu:g}")
+        if mu == 0.6:
+            ax.loglog(r, ip, "s--", color="0.5", label="IP, mu = 0.6")
+        for x, p in rows:
+            lines.append(f"mu = {mu:g}, CF/Fexc = {x:8.1f}: OoP {p['OoP'][1]:.3e} m/N at {p['OoP'][0]:.2f} Hz; "
+                         f"IP {p['IP'][1]:.3e} m/N at {p['IP'][0]:.2f} Hz")
+    ax.invert_xaxis()
+    ax.set_xlabel("force ratio CF / Fexc (excitation grows to the right)")
+    ax.set_ylabel("peak receptance of tip 1 (m/N)")
+    ax.set_title("OoP peak receptance against excitation (cf. paper Fig. 8b)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(OUT / "receptance_vs_force_ratio.png", dpi=100)
+    plt.close(fig)
+    return lines
+
+
+def _plot_rolling(plt, f0):
+    """The IP mode of the rolling damper against the 3-translation model; returns its lines."""
+    roll = read_frf(OUT / "rolling" / "frf.csv")
+    tr = read_frf(OUT / "ip_translations" / "frf.csv")
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(tr["freq_hz"], 1e6 * tr["tip1_h1"], "-", label="3 translations (implicit model)")
+    ax.plot(roll["freq_hz"], 1e6 * roll["tip1_h1"], "--", label="2 points per flank + rotation (rolling)")
+    ax.axvline(f0, color="0.6", ls=":", label="no damper")
+    ax.set_xlabel("f (Hz)")
+    ax.set_ylabel("tip 1 |x_h1| (um), CF/Fexc = 1e4")
+    ax.set_title("IP mode: damper that can roll against the 3-translation model")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(OUT / "ip_rolling.png", dpi=100)
+    plt.close(fig)
+    lines = []
+    for name, d in (("3 translations", tr), ("rolling", roll)):
+        k = int(np.nanargmax(d["tip1_h1"]))
+        lines.append(f"IP, {name}: peak {d['freq_hz'][k]:.2f} Hz, {1e6 * d['tip1_h1'][k]:.2f} um")
+    return lines
+
+
 def main():
     import matplotlib
     matplotlib.use("Agg")
@@ -163,66 +231,13 @@ def main():
     lines.append(f"no damper: 1F {f0:.2f} Hz (IP = OoP)")
     for f, kind in st:
         lines.append(f"damper stuck: {kind} {f:.2f} Hz, shift {100 * (f / f0 - 1):+.1f} %")
-
     frf = read_frf(OUT / "frf" / "frf.csv")
-    base = read_frf(OUT / "nodamper" / "frf.csv")
-    fig, ax = plt.subplots(figsize=(7, 4))
-    ax.semilogy(base["freq_hz"], base["tip1_h1"] / (cf / 1e4), "k:", label="no damper")
-    ax.semilogy(frf["freq_hz"], frf["tip1_h1"] / (cf / 1e4), "-", label="damper, CF/Fexc = 1e4, mu = 0.6")
-    for f, kind in st:
-        ax.axvline(f, color="0.7", lw=0.8)
-        ax.text(f, 1e-6, f" {kind}", fontsize=8)
-    ax.set_xlabel("f (Hz)")
-    ax.set_ylabel("tip 1 receptance |x_h1| / Fexc (m/N)")
-    ax.set_title("UPD rig: IP and OoP 1F modes, one continuation")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(OUT / "frf_ip_oop.png", dpi=100)
-    plt.close(fig)
+    _plot_frf(plt, frf, read_frf(OUT / "nodamper" / "frf.csv"), st, cf)
     pk = mode_peaks(frf, cf / 1e4)
     for k in ("IP", "OoP"):
         lines.append(f"FRF at CF/Fexc = 1e4: {k} peak {pk[k][0]:.2f} Hz, receptance {pk[k][1]:.3e} m/N")
-
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for mu in MUS:
-        rows = sweep_receptance(OUT / f"sweep_mu{mu:g}", cf)
-        r = np.array([x for x, _ in rows])
-        oop = np.array([p["OoP"][1] for _, p in rows])
-        ip = np.array([p["IP"][1] for _, p in rows])
-        ax.loglog(r, oop, "o-", label=f"OoP, mu = {mu:g}")
-        if mu == 0.6:
-            ax.loglog(r, ip, "s--", color="0.5", label="IP, mu = 0.6")
-        for x, p in rows:
-            lines.append(f"mu = {mu:g}, CF/Fexc = {x:8.1f}: OoP {p['OoP'][1]:.3e} m/N at {p['OoP'][0]:.2f} Hz; "
-                         f"IP {p['IP'][1]:.3e} m/N at {p['IP'][0]:.2f} Hz")
-    ax.invert_xaxis()
-    ax.set_xlabel("force ratio CF / Fexc (excitation grows to the right)")
-    ax.set_ylabel("peak receptance of tip 1 (m/N)")
-    ax.set_title("OoP peak receptance against excitation (cf. paper Fig. 8b)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(OUT / "receptance_vs_force_ratio.png", dpi=100)
-    plt.close(fig)
-
-    roll = read_frf(OUT / "rolling" / "frf.csv")
-    tr = read_frf(OUT / "ip_translations" / "frf.csv")
-    fig, ax = plt.subplots(figsize=(7, 4))
-    ax.plot(tr["freq_hz"], 1e6 * tr["tip1_h1"], "-", label="3 translations (implicit model)")
-    ax.plot(roll["freq_hz"], 1e6 * roll["tip1_h1"], "--", label="2 points per flank + rotation (rolling)")
-    ax.axvline(f0, color="0.6", ls=":", label="no damper")
-    ax.set_xlabel("f (Hz)")
-    ax.set_ylabel("tip 1 |x_h1| (um), CF/Fexc = 1e4")
-    ax.set_title("IP mode: damper that can roll against the 3-translation model")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(OUT / "ip_rolling.png", dpi=100)
-    plt.close(fig)
-    for name, d in (("3 translations", tr), ("rolling", roll)):
-        k = int(np.nanargmax(d["tip1_h1"]))
-        lines.append(f"IP, {name}: peak {d['freq_hz'][k]:.2f} Hz, {1e6 * d['tip1_h1'][k]:.2f} um")
+    lines += _plot_sweeps(plt, cf)
+    lines += _plot_rolling(plt, f0)
     (OUT / "results.txt").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     return 0
