@@ -104,23 +104,35 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, cols, X, w, E, 
     linear = (not velocity) and linear_shortcut(kind, p, z, K, f0)
     if linear:
         return U, z, np.zeros((0, nz, Pc)), 0, True, K, f0
-    dz = np.empty((N, nz, Pc))     # every entry written once below (no zero fill first)
+    dz = np.empty((N, nz, Pc))
     if seeds:
-        for j in range(N):
+        _seed(E, dE, w, dth, velocity, dz)
+    return U, z, dz, start_sample(start_rule, n_start, z), False, K, f0
+
+
+@nb.njit(cache=True)
+def _seed(E, dE, w, dth, velocity, dz):
+    """The march's seeds ``dz`` (N, n_z, n_coef n_l + 1), every entry written once (no zero
+    fill first): ``du_{j a}/dU_{m b} = E_{j m} delta_{a b}``, for velocity laws also
+    ``d(du)_{j a}/dU_{m b} = w E'_{j m} delta_{a b}`` and ``d(du)_{j a}/dw = dth_{j a}``
+    (``dth`` (N, n_l) the phase derivative of ``u``), and 0 by ``w`` for the displacements."""
+    N, nc = E.shape
+    nl = dth.shape[1]
+    Pc = dz.shape[2]
+    for j in range(N):
+        for a in range(nl):
+            for m in range(nc):
+                e = E[j, m]
+                for b in range(nl):
+                    dz[j, a, m * nl + b] = e if a == b else 0.0
+            dz[j, a, Pc - 1] = 0.0
+        if velocity:
             for a in range(nl):
                 for m in range(nc):
-                    e = E[j, m]
+                    de = w * dE[j, m]
                     for b in range(nl):
-                        dz[j, a, m * nl + b] = e if a == b else 0.0
-                dz[j, a, Pc - 1] = 0.0
-            if velocity:
-                for a in range(nl):
-                    for m in range(nc):
-                        de = w * dE[j, m]
-                        for b in range(nl):
-                            dz[j, nl + a, m * nl + b] = de if a == b else 0.0
-                    dz[j, nl + a, Pc - 1] = dth[j, a]
-    return U, z, dz, start_sample(start_rule, n_start, z), False, K, f0
+                        dz[j, nl + a, m * nl + b] = de if a == b else 0.0
+                dz[j, nl + a, Pc - 1] = dth[j, a]
 
 
 @nb.njit(cache=True)
