@@ -55,6 +55,13 @@ from scipy.linalg.lapack import dgesv, dgetrs
 REUSE_MIN_SIZE = 800      # below this a fresh LU is cheaper than a few Krylov iterations
 BLOCK_MIN_SIZE = 250      # below this a fresh LU is cheaper than block LUs and a Krylov step
 APPROXIMATE_PAUSE = 8     # calls that skip a caller's approximate inverse after it failed
+# when the blocks pay (_blocks_pay): one block's solve costs about BLOCK_SECONDS whatever its
+# size up to 100 rows (scipy's call, measured 11-15 us), a solve takes about KRYLOV_STEPS
+# preconditioned steps, and LAPACK's dense LU solve runs at about DENSE_RATE n^3 per second
+# on one thread (measured 3.1e10 at 306 unknowns, 3.6e10 at 500)
+BLOCK_SECONDS = 15e-6
+KRYLOV_STEPS = 8
+DENSE_RATE = 3e10
 
 
 def _usable(lu) -> bool:
@@ -320,13 +327,22 @@ def make_solver(n: int, blocks=None, scale=None):
     """The linear solver for systems of ``n`` unknowns: :class:`BlockPreconditioned` on
     ``blocks`` (``(start, stop)`` ranges of the unknowns, or a :class:`Structure`, whose
     approximate inverse is then tried first on matrices scaled by columns by ``scale``)
-    when given and ``n`` reaches :data:`BLOCK_MIN_SIZE`, else :class:`ReusedLU` from
+    when given, ``n`` reaches :data:`BLOCK_MIN_SIZE` and the blocks pay (:func:`_blocks_pay`,
+    or an approximate inverse is given), else :class:`ReusedLU` from
     :data:`REUSE_MIN_SIZE`, else :func:`direct_solve`.  (Measured on a 16-contact FE patch,
     336 unknowns: FRF 2.06 s direct, 1.66 s on the blocks; at 84 and 168 unknowns the direct
     LU is 20 % and 12 % faster.)"""
     approximate = None
     if isinstance(blocks, Structure):
         blocks, approximate = blocks
-    if blocks and n >= BLOCK_MIN_SIZE:
+    if blocks and n >= BLOCK_MIN_SIZE and (approximate is not None or _blocks_pay(n, blocks)):
         return BlockPreconditioned(blocks, approximate=approximate, scale=scale)
     return ReusedLU() if n >= REUSE_MIN_SIZE else direct_solve
+
+
+def _blocks_pay(n: int, blocks) -> bool:
+    """Whether ``KRYLOV_STEPS`` steps preconditioned by one solve per block cost less than a
+    dense LU solve of ``n`` unknowns.  Many small blocks do not pay: the railcar rig (6 DOFs,
+    H = 25: 306 unknowns in 26 blocks) traced 36-40 Hz in 72.5 s on the blocks and in 38.8 s
+    by dense LUs; a 16-contact patch at H = 3 (336 unknowns in 4 blocks) is faster on them."""
+    return len(blocks) * BLOCK_SECONDS * KRYLOV_STEPS < n ** 3 / DENSE_RATE
