@@ -29,6 +29,24 @@ def test_a_stall_is_restarted_past_and_stated():
     assert sum(e - s for s, e in res.settings["segments"]) == res.freq_hz.size
 
 
+def test_where_no_restart_converges_the_window_is_traced_from_its_top(monkeypatch):
+    """The railcar rig's case (rigs/railcar_wedge.toml: no restart past its stop at 30.33 Hz
+    converged, and 30.33-40 Hz were left untraced) on the stiff chain with restarts made to
+    fail: the branch through fmax is traced down towards the stop, the stretch between stated."""
+    import hbm.analyses.trace as trace
+    monkeypatch.setattr(trace, "_fresh_point_past", lambda *a, **k: "no restart (test)")
+    case = hbm.case_from_dict(cases.jenkins_chain3(1.0, 1.0, 1e4, 5))
+    res = hbm.frf(case, stability=False, error_estimate=False)
+    lo, hi = res.settings["fmin_hz"], res.settings["fmax_hz"]
+    assert res.status == "finished" and res.freq_hz[0] == lo and abs(res.freq_hz[-1] - hi) <= 1e-9 * hi
+    (g,) = res.settings["gaps"]
+    assert "no restart (test)" in g["reason"] and "not traced" in res.settings["gap_warning"]
+    a, b = res.settings["segments"]
+    assert a[1] == b[0] and b[1] == res.freq_hz.size
+    assert res.freq_hz[a[1] - 1] == g["from_hz"] and res.freq_hz[b[0]] == g["to_hz"]
+    assert res.energy_error.max() < 1e-8
+
+
 # ------------------------------------------------------------------ restarts on a traced branch
 def duffing_setup():
     """The hardening Duffing of tests/test_duffing.py (three solutions between its folds), its
@@ -102,8 +120,8 @@ def test_a_gap_states_how_much_the_response_changes_across_it():
 
 
 def test_a_gap_of_no_visible_width_is_named_a_corner():
-    from hbm.analyses.trace import _gap_text
-    corner = _gap_text({"from_hz": 15.8365, "to_hz": 15.8365 * (1 + 3e-8), "h1_change": 6e-6, "change": 6e-3})
+    from hbm.analyses.gaps import gap_text
+    corner = gap_text({"from_hz": 15.8365, "to_hz": 15.8365 * (1 + 3e-8), "h1_change": 6e-6, "change": 6e-3})
     assert "15.8365 Hz (a corner of the path, 3e-08 of the frequency wide)" in corner and "6.0e-06" in corner
-    gap = _gap_text({"from_hz": 0.2087, "to_hz": 0.2221, "h1_change": 1.0, "change": 1.5})
+    gap = gap_text({"from_hz": 0.2087, "to_hz": 0.2221, "h1_change": 1.0, "change": 1.5})
     assert gap.startswith("0.2087..0.2221 Hz (outputs across it") and "corner" not in gap

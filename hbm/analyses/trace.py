@@ -6,7 +6,8 @@ traces the branch upwards by :class:`continuation.Arclength` (:func:`_trace`: ev
 energy balance checked, loose ones polished), restarts past a stop the corrector cannot
 pass (:func:`_restart_past_stops`, every skipped stretch stated; a fresh point from the
 linear responses or, failing them, from a time integration's periodic response,
-:mod:`hbm.analyses.td_start`), and traces from ``fmax``
+:mod:`hbm.analyses.td_start`; where no restart converges, the branch through ``fmax`` traced
+down towards the stop, :func:`_top_down_past_stop`), and traces from ``fmax``
 down what a branch folding back out at ``fmin`` leaves.  When no first point converges at
 ``fmin`` (a stiff contact in stick-slip there, where Newton, the force ramp and its
 arclength version all fail), the window is traced from ``fmax`` down instead, and the
@@ -18,6 +19,7 @@ import numpy as np
 
 from continuation import Arclength
 
+from hbm.analyses.gaps import jump, state_gaps
 from hbm.analyses.problem_setup import _first_point, recover_outputs
 from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
 from hbm.balance.energy import energy_balance
@@ -162,7 +164,6 @@ GAP_FIRST = 1e-3        # first restart this share of the window past a stop, do
 GAP_TRIES = 8
 TD_TRIES, TD_EVERY = 2, 3      # time-domain starts past a stop: at 1 and 8 times GAP_FIRST
 MAX_GAPS = 10
-CORNER = 1e-6           # a gap narrower than this share of its frequency is named a corner
 
 
 def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, opts, progress, lam_step,
@@ -202,41 +203,56 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
         w_reached = min(back.w) if back.w else restart[2]
         if w_reached > w_from * (1 + 1e-9):
             gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": w_reached / (2 * np.pi), "reason": message,
-                         **_jump(problem.basis, pts.Y[start - 1], back.Y[-1] if back.w else
+                         **jump(problem.basis, pts.Y[start - 1], back.Y[-1] if back.w else
                                  recover_outputs(problem, case, restart[0], restart[2]))})
         status, message, f2, r2 = _trace(problem, case, pts, restart[0], restart[1], restart[2], (w_lo, w_hi), +1,
                                          xscale, r_scale, opts, progress, offset=0, lam_step=lam_step)
         folds, n_rej = folds + f2, n_rej + r2
         segments.append([start, len(pts.w)])
-    if gaps:
-        settings["gaps"] = gaps
-        where = ", ".join(_gap_text(g) for g in gaps)
-        settings["gap_warning"] = (f"the continuation stopped {len(gaps)} time(s) and was restarted further on; "
-                                   f"not traced: {where} (first stop: {gaps[0]['reason']})")
+    state_gaps(settings, gaps)
     return status, message, folds, n_rej
 
 
-def _gap_text(g: dict) -> str:
-    """One gap for the warning; a gap narrower than ``CORNER`` of its frequency is called a
-    corner of the path (e.g. a stuck slider's offset that jumps when it starts to slip)."""
-    width = (g["to_hz"] - g["from_hz"]) / g["from_hz"]
-    where = (f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz" if width >= CORNER else
-             f"{g['from_hz']:.8g} Hz (a corner of the path, {width:.0e} of the frequency wide)")
-    return f"{where} (outputs across it: first harmonics {g['h1_change']:.1e}, whole response {g['change']:.1e})"
+def _start_at(problem, case, w, xscale, r_scale):
+    """``(X, iterations)`` at ``w``: Newton from the linear responses, failing them from a time
+    integration (:mod:`hbm.analyses.td_start`); RuntimeError saying why neither converged."""
+    try:
+        return _first_point(problem, case, w, xscale, r_scale)
+    except RuntimeError as exc:
+        try:
+            return time_domain_start(problem, case, w, xscale, r_scale)
+        except RuntimeError as exc2:
+            raise RuntimeError(f"{exc}; {exc2}") from exc2
 
 
-def _jump(basis, Ya: np.ndarray, Yb: np.ndarray) -> dict:
-    """How much the outputs (n_coef, n_out) change across a gap, relative, for the output that
-    changes most: ``h1_change`` of the first-harmonic amplitude, ``change`` of all its
-    coefficients (a gap of no width may be a jump of the mean only: a stuck slider's offset)."""
-    def rel(a, b):
-        return float(np.max(np.abs(a - b) / np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-300)))
-    h1 = 0.0
-    if 1 in basis.harmonics:
-        rows = [basis.row_of(1, "c"), basis.row_of(1, "s")]
-        h1 = rel(np.hypot(*Ya[rows]), np.hypot(*Yb[rows]))
-    size = np.maximum(np.linalg.norm(Ya, axis=0), np.linalg.norm(Yb, axis=0))
-    return {"h1_change": h1, "change": float(np.max(np.linalg.norm(Ya - Yb, axis=0) / np.maximum(size, 1e-300)))}
+def _top_down_past_stop(problem, case, pts, segments, window, xscale, r_scale, opts, progress, lam_step,
+                        outcome, settings):
+    """Where the path stopped and no restart past the stop converged: the branch through a
+    point at ``fmax`` traced down towards the stop, so that only what neither side reaches is
+    untraced (a gap, stated; the window's top is then covered and the run finishes past it).
+    The outcome unchanged, its message extended, when no point at ``fmax`` converges."""
+    status, message, folds, n_rej = outcome
+    w_stop, w_hi = pts.w[-1], window[1]
+    try:
+        Xh, ith = _start_at(problem, case, w_hi, xscale, r_scale)
+    except RuntimeError as exc:
+        return status, f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down neither: {exc}", folds, n_rej
+    part = TracedPoints()
+    st2, msg2, f2, r2 = _trace(problem, case, part, Xh, ith, w_hi, (w_stop, w_hi), -1, xscale, r_scale, opts,
+                               progress, offset=len(pts.w), lam_step=lam_step)
+    if not part.w:
+        return status, f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down neither: {msg2}", folds, n_rej
+    start = len(pts.w)
+    pts.extend_reversed(part)
+    segments.append([start, len(pts.w)])
+    w_reached = min(part.w)
+    if w_reached > w_stop * (1 + 1e-9):
+        why = message if st2 == "finished" else f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down: {msg2}"
+        gaps = settings.get("gaps", []) + [{"from_hz": w_stop / (2 * np.pi), "to_hz": w_reached / (2 * np.pi),
+                                            "reason": why, **jump(problem.basis, pts.Y[start - 1], pts.Y[start])}]
+        state_gaps(settings, gaps)
+    return "finished", f"traced from {w_hi / (2 * np.pi):.6g} Hz down to {w_reached / (2 * np.pi):.6g} Hz", \
+        folds + f2, n_rej + r2
 
 
 def _fresh_point_past(problem, case, w_from, window, xscale, r_scale, traced):
@@ -300,8 +316,12 @@ def trace_window(problem, case, window, xscale, r_scale, opts, progress, setting
     outcome = _trace(problem, case, pts, X0, it0, w_lo, window, +1, xscale, r_scale, opts, progress,
                      lam_step=lam_step)
     segments.append([0, len(pts.w)])
-    status, message, folds, n_rej = _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale,
-                                                        opts, progress, lam_step, outcome, settings)
+    outcome = _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, opts, progress,
+                                  lam_step, outcome, settings)
+    if outcome[0] == "failed" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9) and len(pts.w) < case.analysis.max_points:
+        outcome = _top_down_past_stop(problem, case, pts, segments, window, xscale, r_scale, opts, progress,
+                                      lam_step, outcome, settings)
+    status, message, folds, n_rej = outcome
     if status == "finished" and pts.w and pts.w[-1] < w_hi * (1 - 1e-9):
         # the branch folded back out of the window at fmin (e.g. a softening upper branch):
         # the rest of the window lies on another branch, traced from fmax downwards
@@ -328,14 +348,14 @@ def trace_window(problem, case, window, xscale, r_scale, opts, progress, setting
 
 
 def _down_from_fmax(problem, case, window, xscale, r_scale, opts, progress, lam_step, offset=0, widen=False):
-    """The branch through a first point at ``fmax``, traced down (points highest frequency
-    first); raises RuntimeError when that first point does not converge.
+    """The branch through a first point at ``fmax`` (:func:`_start_at`), traced down (points
+    highest frequency first); raises RuntimeError when that first point does not converge.
 
     Returns ``(part, outcome, xscale, folded)``: the points, ``(status, message, folds_hz,
     n_rejected)``, the scale (widened by the first point if ``widen``), and whether the
     branch left the window again at ``fmax`` (folded back) instead of reaching ``fmin``."""
     w_lo, w_hi = window
-    Xh, ith = _first_point(problem, case, w_hi, xscale, r_scale)
+    Xh, ith = _start_at(problem, case, w_hi, xscale, r_scale)
     if widen:
         xscale = _widened_scale(problem, xscale, Xh)
     part = TracedPoints()
