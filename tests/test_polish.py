@@ -1,10 +1,10 @@
-"""The fixed-frequency polish of a traced point (hbm.analyses.trace._polish): it runs Newton
+"""The fixed-frequency polish of a traced point (hbm.analyses.polish.polish): it runs Newton
 when the residual's work explains the energy imbalance, and returns the point after one
 evaluation when it cannot (the imbalance is then not the residual's, so no update closes it)."""
 import numpy as np
 
 from hbm.analyses.problem_setup import solve_at
-from hbm.analyses.trace import _polish
+from hbm.analyses.polish import polish as _polish
 from hbm.balance.energy import EnergyBalance
 from test_truncation import three_dof
 
