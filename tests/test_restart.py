@@ -47,6 +47,33 @@ def test_where_no_restart_converges_the_window_is_traced_from_its_top(monkeypatc
     assert res.energy_error.max() < 1e-8
 
 
+def test_the_branch_from_the_top_is_restarted_below_its_own_stops(monkeypatch):
+    """With restarts above the upward stop (0.0608 Hz) made to fail, the branch from fmax
+    stops on its way down at 0.0763 Hz, is restarted below that (down to the upward stop), and
+    the gap between states both stops and why no restart converged."""
+    import hbm.analyses.trace as trace
+    fresh = trace._fresh_point_past
+
+    def upward_fails(*a, direction=1, **k):
+        return "no restart (test)" if direction > 0 else fresh(*a, direction=direction, **k)
+    monkeypatch.setattr(trace, "_fresh_point_past", upward_fails)
+
+    def no_time_domain(*a, **k):          # (600 periods from rest: 15 s, not periodic either)
+        raise RuntimeError("no time-domain start (test)")
+    monkeypatch.setattr(trace, "time_domain_start", no_time_domain)
+    case = hbm.case_from_dict(cases.jenkins_chain3(1.0, 1.0, 1e4, 5))
+    res = hbm.frf(case, stability=False, error_estimate=False)
+    hi = res.settings["fmax_hz"]
+    assert res.status == "finished" and abs(res.freq_hz[-1] - hi) <= 1e-9 * hi
+    for g in res.settings["gaps"]:
+        inside = (res.freq_hz > g["from_hz"] * (1 + 1e-9)) & (res.freq_hz < g["to_hz"] * (1 - 1e-9))
+        assert not inside.any()
+    why = " ".join(g["reason"] for g in res.settings["gaps"])
+    assert "no restart (test)" in why and "Hz down: " in why and "no restart below it converged" in why
+    assert sum(e - s for s, e in res.settings["segments"]) == res.freq_hz.size
+    assert res.energy_error.max() < 1e-8
+
+
 # ------------------------------------------------------------------ restarts on a traced branch
 def duffing_setup():
     """The hardening Duffing of tests/test_duffing.py (three solutions between its folds), its

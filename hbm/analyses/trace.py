@@ -156,34 +156,82 @@ def _start_at(problem, case, w, xscale, r_scale):
 def _top_down_past_stop(problem, case, pts, segments, window, xscale, r_scale, opts, progress, lam_step,
                         outcome, settings):
     """Where the path stopped and no restart past the stop converged: the branch through a
-    point at ``fmax`` traced down towards the stop, so that only what neither side reaches is
-    untraced (a gap, stated; the window's top is then covered and the run finishes past it).
-    The outcome unchanged, its message extended, when no point at ``fmax`` converges."""
+    point at ``fmax`` traced down towards the stop, restarted past its own stops as the upward
+    path is (:func:`_down_past_stops`), so that only what neither side reaches is untraced
+    (gaps, stated; the window's top is then covered and the run finishes past them).  The
+    outcome unchanged, its message extended, when no point at ``fmax`` converges."""
     status, message, folds, n_rej = outcome
     w_stop, w_hi = pts.w[-1], window[1]
     try:
-        Xh, ith = _start_at(problem, case, w_hi, xscale, r_scale)
+        X, it = _start_at(problem, case, w_hi, xscale, r_scale)
     except RuntimeError as exc:
         return status, f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down neither: {exc}", folds, n_rej
-    part = TracedPoints()
-    st2, msg2, f2, r2 = _trace(problem, case, part, Xh, ith, w_hi, (w_stop, w_hi), -1, xscale, r_scale, opts,
-                               progress, offset=len(pts.w), lam_step=lam_step)
-    if not part.w:
-        return status, f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down neither: {msg2}", folds, n_rej
-    start = len(pts.w)
-    pts.extend_reversed(part)
-    segments.append([start, len(pts.w)])
-    w_reached = min(part.w)
-    if w_reached > w_stop * (1 + 1e-9):
-        why = message if st2 == "finished" else f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down: {msg2}"
-        gaps = settings.get("gaps", []) + [{"from_hz": w_stop / (2 * np.pi), "to_hz": w_reached / (2 * np.pi),
-                                            "reason": why, **jump(problem.basis, pts.Y[start - 1], pts.Y[start])}]
-        state_gaps(settings, gaps)
-    return "finished", f"traced from {w_hi / (2 * np.pi):.6g} Hz down to {w_reached / (2 * np.pi):.6g} Hz", \
-        folds + f2, n_rej + r2
+    parts, ends, f2, r2 = _down_past_stops(problem, case, (X, it, w_hi), w_stop, len(pts.w), window, xscale,
+                                           r_scale, opts, progress, lam_step)
+    if not parts:
+        return status, f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down neither: {ends[w_hi]}", folds, n_rej
+    ends[w_stop] = message
+    spans = [(w_stop, w_stop, len(pts.w) - 1, len(pts.w) - 1)]
+    for part, down in sorted(parts, key=lambda pd: (min(pd[0].w), not pd[1])):
+        start = len(pts.w)
+        if down:
+            pts.extend_reversed(part)
+        else:                   # traced up from a restart, which the part down from it holds
+            pts.extend(part, skip_first=True)
+        if len(pts.w) > start:
+            segments.append([start, len(pts.w)])
+            spans.append((pts.w[start], pts.w[-1], start, len(pts.w) - 1))
+    gaps = list(settings.get("gaps", []))
+    for (_, a, _, ia), (b, _, ib, _) in zip(spans[:-1], spans[1:]):
+        if b > a * (1 + 1e-9):
+            why = "; ".join(m for m in (ends.get(a), ends.get(b)) if m)
+            gaps.append({"from_hz": a / (2 * np.pi), "to_hz": b / (2 * np.pi), "reason": why,
+                         **jump(problem.basis, pts.Y[ia], pts.Y[ib])})
+    state_gaps(settings, gaps)
+    return "finished", f"traced from {w_hi / (2 * np.pi):.6g} Hz down", folds + f2, n_rej + r2
 
 
-def _fresh_point_past(problem, case, w_from, window, xscale, r_scale, traced):
+def _down_past_stops(problem, case, first, w_stop, offset, window, xscale, r_scale, opts, progress, lam_step):
+    """The branch through ``first = (X, iterations, w)`` traced down to ``w_stop``, restarted
+    below each of its stops (:func:`_fresh_point_past` downwards, then traced up towards the
+    stop and on down), at most ``MAX_GAPS`` times.
+
+    Returns ``(parts, ends, folds_hz, n_rejected)``: ``(TracedPoints, down)`` per traced part
+    (``down``: highest frequency first), and ``ends``, why a part ended, by the frequency
+    (rad/s) where it did (a stop going down, a stop going up, or no point at ``first``)."""
+    X, it, w_from = first
+    parts, ends, folds, n_rej = [], {}, [], 0
+    for _ in range(MAX_GAPS):
+        part = TracedPoints()
+        st, msg, f, r = _trace(problem, case, part, X, it, w_from, (w_stop, w_from), -1, xscale, r_scale, opts,
+                               progress, offset=offset + sum(len(p.w) for p, _ in parts), lam_step=lam_step)
+        folds, n_rej = folds + f, n_rej + r
+        if not part.w:
+            ends[w_from] = msg
+            break
+        parts.append((part, True))
+        w_low = part.w[-1]                  # where it stopped
+        if (st == "finished" or w_low <= w_stop * (1 + 1e-9)
+                or offset + sum(len(p.w) for p, _ in parts) >= case.analysis.max_points):
+            break
+        restart = _fresh_point_past(problem, case, w_low, window, xscale, r_scale, part, direction=-1,
+                                    limit=w_stop)
+        if isinstance(restart, str):
+            ends[w_low] = f"from {w_from / (2 * np.pi):.6g} Hz down: {msg}; no restart below it converged ({restart})"
+            break
+        ends[w_low] = f"from {w_from / (2 * np.pi):.6g} Hz down: {msg}"
+        X, it, w_from = restart
+        back = TracedPoints()
+        st, msg, f, r = _trace(problem, case, back, X, it, w_from, (w_from, w_low), +1, xscale, r_scale, opts,
+                               progress, offset=offset + sum(len(p.w) for p, _ in parts), lam_step=lam_step)
+        folds, n_rej = folds + f, n_rej + r
+        parts.append((back, False))
+        if st != "finished":
+            ends[back.w[-1]] = f"from {w_from / (2 * np.pi):.6g} Hz up: {msg}"
+    return parts, ends, folds, n_rej
+
+
+def _fresh_point_past(problem, case, w_from, window, xscale, r_scale, traced, direction=1, limit=None):
     """``(X, iterations, w)`` solved a little past a stop at ``w_from``: Newton from the linear
     responses at ``GAP_FIRST`` of the window past it, doubled up to ``GAP_TRIES`` times; failing
     all, from a time integration's periodic response at the first and every ``TD_EVERY``-th
@@ -191,9 +239,12 @@ def _fresh_point_past(problem, case, w_from, window, xscale, r_scale, traced):
     models).  A solution on the path ``traced`` so far is not a restart: where the path
     stopped on a fold's middle branch, the linear starts land on the branch already traced
     (which the same fold would then send round again).  When nothing converges with a closed
-    energy balance: why the time-domain start failed (str)."""
+    energy balance: why the time-domain start failed (str).  ``direction = -1``: below a stop
+    of a path traced downwards, down to ``limit`` (default: the window's other end)."""
     w_lo, w_hi = window
-    ladder = sorted({min(w_from + GAP_FIRST * 2 ** k * (w_hi - w_lo), w_hi) for k in range(GAP_TRIES)})
+    limit = (w_hi if direction > 0 else w_lo) if limit is None else limit
+    ladder = sorted({min(max(w_from + direction * GAP_FIRST * 2 ** k * (w_hi - w_lo), min(limit, w_from)),
+                         max(limit, w_from)) for k in range(GAP_TRIES)}, reverse=direction < 0)
     starts = [(w_r, lambda w_r: _first_point(problem, case, w_r, xscale, r_scale, arclength_ramp=False,
                                              avoid=lambda X, w_r=w_r: traced.passes(X, w_r)))
               for w_r in ladder]

@@ -15,6 +15,12 @@ class TracedPoints:
     def __init__(self):
         self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
 
+    def extend(self, other: "TracedPoints", skip_first: bool = False) -> None:
+        """Append ``other``'s points in order (without its first point if ``skip_first``)."""
+        k = 1 if skip_first else 0
+        for name in self.FIELDS:
+            getattr(self, name).extend(getattr(other, name)[k:])
+
     def extend_reversed(self, other: "TracedPoints", skip_first: bool = False) -> None:
         """Append ``other``'s points in reverse order (without its first point if ``skip_first``)."""
         k = 1 if skip_first else 0
