@@ -83,3 +83,19 @@ def test_friction_against_moving_support_matches_hbm():
 def test_switch_off_with_base_is_an_error():
     with pytest.raises(CaseError, match="switch-off"):
         transient(base_case(), 3.0, 4, switch_off_at=0.5, options=TimeSimOptions(steps=32))
+
+
+@pytest.mark.parametrize("fs", [None, 0.3])
+def test_floquet_check_of_a_base_excited_balance_point(fs):
+    """The period map runs with the support on its imposed motion (the railcar rig's Hill
+    verdicts are checked this way): without friction the largest multiplier is the damped
+    free motion's decay over a period, exp(-c T / 2 m); with a slipping Jenkins element the
+    orbit is the balance point's and stable."""
+    from hbm.analyses.problem_setup import solve_at
+    from hbm.timedomain.floquet_check import check_point
+    case = base_case(fs=fs)
+    X, basis, _ = solve_at(case, 3.0)
+    chk = check_point(case, basis, X, 3.0, steps=512)
+    assert chk.converged and chk.stable and chk.distance < 1e-3
+    if fs is None:
+        assert chk.largest == pytest.approx(np.exp(-0.5 / (2 * 2.0) / 3.0), rel=1e-5)

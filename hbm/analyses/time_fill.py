@@ -180,7 +180,7 @@ def wanted(res) -> bool:
 def _shoot(case, res, problem, i: int) -> dict | None:
     """The check of path point ``i`` by shooting from it (module doc) as a record like
     :func:`_simulate`'s, with ``method``, ``stable`` and ``largest_multiplier``; None when
-    shooting cannot be used (support excitation, a velocity law) or does not converge.
+    shooting cannot be used (a velocity law) or does not converge.
     ``problem``: the condensed balance the point solves (None for a full model)."""
     from hbm.timedomain.floquet_check import check_point
     from hbm.timedomain.time_results import TimeSimOptions
