@@ -6,6 +6,7 @@ import pathlib
 import sys
 
 import hbm
+import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "stress"))
@@ -152,3 +153,37 @@ def test_a_gap_of_no_visible_width_is_named_a_corner():
     assert "15.8365 Hz (a corner of the path, 3e-08 of the frequency wide)" in corner and "6.0e-06" in corner
     gap = gap_text({"from_hz": 0.2087, "to_hz": 0.2221, "h1_change": 1.0, "change": 1.5})
     assert gap.startswith("0.2087..0.2221 Hz (outputs across it") and "corner" not in gap
+
+
+def _part(ws):
+    import numpy as np
+    from hbm.analyses.traced_points import TracedPoints
+    p = TracedPoints()
+    for w in ws:
+        p.X.append(np.zeros((3, 1)))
+        p.w.append(w)
+        p.Y.append(np.full((3, 1), w))
+        p.its.append(1)
+        p.err.append(0.0)
+        p.unclosed.append(0)
+    return p
+
+
+def test_parts_from_the_top_join_at_their_restarts_and_leave_only_real_gaps():
+    """The railcar's case: a part down from fmax stops at 3.0, a restart at 2.9 is traced down
+    to 2.0 (stopped) and up to 3.0 (or stalls at 2.95): the restart joins its two parts, so the
+    gaps are 1.0-2.0 (and 2.95-3.0), never a sliver between the restart and the next point up
+    (a 0.0002 Hz "corner" the railcar's first run reported)."""
+    from hbm.analyses.trace import _merge_parts
+    from hbm.balance.fourier import FourierBasis
+    basis = FourierBasis([0, 1], 8)
+    for back, expected in (([2.9, 2.95, 3.0], [(1.0, 2.0)]), ([2.9, 2.95], [(1.0, 2.0), (2.95, 3.0)])):
+        pts, segments = _part([0.5, 1.0]), [[0, 2]]
+        parts = [(_part([4.0, 3.5, 3.0]), True), (_part([2.9, 2.5, 2.0]), True), (_part(back), False)]
+        ends = {1.0: "up stop", 3.0: "down stop", 2.0: "second down stop", 2.95: "up from 2.9"}
+        gaps = _merge_parts(pts, segments, parts, ends, basis)
+        assert [(g["from_hz"] * 2 * 3.141592653589793, g["to_hz"] * 2 * 3.141592653589793) for g in gaps] == \
+            [pytest.approx(e) for e in expected]
+        assert pts.w == sorted(pts.w) and len(pts.w) == 2 + 3 + 3 + len(back) - 1
+        assert sum(e - s for s, e in segments) == len(pts.w)
+        assert gaps[0]["reason"] == "up stop; second down stop"

@@ -171,7 +171,17 @@ def _top_down_past_stop(problem, case, pts, segments, window, xscale, r_scale, o
     if not parts:
         return status, f"{message}; from {w_hi / (2 * np.pi):.6g} Hz down neither: {ends[w_hi]}", folds, n_rej
     ends[w_stop] = message
-    spans = [(w_stop, w_stop, len(pts.w) - 1, len(pts.w) - 1)]
+    gaps = list(settings.get("gaps", [])) + _merge_parts(pts, segments, parts, ends, problem.basis)
+    state_gaps(settings, gaps)
+    return "finished", f"traced from {w_hi / (2 * np.pi):.6g} Hz down", folds + f2, n_rej + r2
+
+
+def _merge_parts(pts, segments, parts, ends, basis) -> list:
+    """Append the ``parts`` of :func:`_down_past_stops` to ``pts`` (lowest frequency first, a
+    segment each) above its last point, and return the gaps between them: where the upper
+    end of one (its last point, or the restart a part traced up from starts at, which the
+    part traced down from it holds) lies below the lower end of the next; ``ends`` give why."""
+    spans = [(pts.w[-1], pts.w[-1], len(pts.w) - 1, len(pts.w) - 1)]     # (lo, hi, i_lo, i_hi)
     for part, down in sorted(parts, key=lambda pd: (min(pd[0].w), not pd[1])):
         start = len(pts.w)
         if down:
@@ -180,15 +190,15 @@ def _top_down_past_stop(problem, case, pts, segments, window, xscale, r_scale, o
             pts.extend(part, skip_first=True)
         if len(pts.w) > start:
             segments.append([start, len(pts.w)])
-            spans.append((pts.w[start], pts.w[-1], start, len(pts.w) - 1))
-    gaps = list(settings.get("gaps", []))
+            lo = pts.w[start] if down else part.w[0]
+            spans.append((lo, pts.w[-1], start, len(pts.w) - 1))
+    gaps = []
     for (_, a, _, ia), (b, _, ib, _) in zip(spans[:-1], spans[1:]):
         if b > a * (1 + 1e-9):
             why = "; ".join(m for m in (ends.get(a), ends.get(b)) if m)
             gaps.append({"from_hz": a / (2 * np.pi), "to_hz": b / (2 * np.pi), "reason": why,
-                         **jump(problem.basis, pts.Y[ia], pts.Y[ib])})
-    state_gaps(settings, gaps)
-    return "finished", f"traced from {w_hi / (2 * np.pi):.6g} Hz down", folds + f2, n_rej + r2
+                         **jump(basis, pts.Y[ia], pts.Y[ib])})
+    return gaps
 
 
 def _down_past_stops(problem, case, first, w_stop, offset, window, xscale, r_scale, opts, progress, lam_step):
@@ -225,9 +235,10 @@ def _down_past_stops(problem, case, first, w_stop, offset, window, xscale, r_sca
         st, msg, f, r = _trace(problem, case, back, X, it, w_from, (w_from, w_low), +1, xscale, r_scale, opts,
                                progress, offset=offset + sum(len(p.w) for p, _ in parts), lam_step=lam_step)
         folds, n_rej = folds + f, n_rej + r
-        parts.append((back, False))
-        if st != "finished":
-            ends[back.w[-1]] = f"from {w_from / (2 * np.pi):.6g} Hz up: {msg}"
+        if back.w:
+            parts.append((back, False))
+            if st != "finished":
+                ends[back.w[-1]] = f"from {w_from / (2 * np.pi):.6g} Hz up: {msg}"
     return parts, ends, folds, n_rej
 
 
