@@ -211,34 +211,37 @@ def _down_past_stops(problem, case, first, w_stop, offset, window, xscale, r_sca
     (rad/s) where it did (a stop going down, a stop going up, or no point at ``first``)."""
     X, it, w_from = first
     parts, ends, folds, n_rej = [], {}, [], 0
-    for _ in range(MAX_GAPS):
+
+    def run(X, it, w0, bounds, direction):
+        """One part traced from ``(X, w0)`` (kept when it has points): ``(part, status, message)``."""
+        nonlocal folds, n_rej
         part = TracedPoints()
-        st, msg, f, r = _trace(problem, case, part, X, it, w_from, (w_stop, w_from), -1, xscale, r_scale, opts,
-                               progress, offset=offset + sum(len(p.w) for p, _ in parts), lam_step=lam_step)
+        st, msg, f, r = _trace(problem, case, part, X, it, w0, bounds, direction, xscale, r_scale, opts, progress,
+                               offset=offset + sum(len(p.w) for p, _ in parts), lam_step=lam_step)
         folds, n_rej = folds + f, n_rej + r
+        if part.w:
+            parts.append((part, direction < 0))
+        return part, st, msg
+
+    for _ in range(MAX_GAPS):
+        part, st, msg = run(X, it, w_from, (w_stop, w_from), -1)
         if not part.w:
             ends[w_from] = msg
             break
-        parts.append((part, True))
         w_low = part.w[-1]                  # where it stopped
         if (st == "finished" or w_low <= w_stop * (1 + 1e-9)
                 or offset + sum(len(p.w) for p, _ in parts) >= case.analysis.max_points):
             break
         restart = _fresh_point_past(problem, case, w_low, window, xscale, r_scale, part, direction=-1,
                                     limit=w_stop)
-        if isinstance(restart, str):
-            ends[w_low] = f"from {w_from / (2 * np.pi):.6g} Hz down: {msg}; no restart below it converged ({restart})"
-            break
         ends[w_low] = f"from {w_from / (2 * np.pi):.6g} Hz down: {msg}"
+        if isinstance(restart, str):
+            ends[w_low] += f"; no restart below it converged ({restart})"
+            break
         X, it, w_from = restart
-        back = TracedPoints()
-        st, msg, f, r = _trace(problem, case, back, X, it, w_from, (w_from, w_low), +1, xscale, r_scale, opts,
-                               progress, offset=offset + sum(len(p.w) for p, _ in parts), lam_step=lam_step)
-        folds, n_rej = folds + f, n_rej + r
-        if back.w:
-            parts.append((back, False))
-            if st != "finished":
-                ends[back.w[-1]] = f"from {w_from / (2 * np.pi):.6g} Hz up: {msg}"
+        back, st, msg = run(X, it, w_from, (w_from, w_low), +1)
+        if back.w and st != "finished":
+            ends[back.w[-1]] = f"from {w_from / (2 * np.pi):.6g} Hz up: {msg}"
     return parts, ends, folds, n_rej
 
 
