@@ -1,4 +1,4 @@
-"""Hill's eigenproblem split by harmonic parity (:func:`hbm.analyses.stability_path.parity_groups`).
+"""Hill's eigenproblem split by harmonic parity (:func:`hbm.analyses.stability_path.hill_blocks`).
 
 A half-wave symmetric response couples a perturbation's even harmonics only to even ones and
 its odd only to odd ones; the Hill matrix is then block diagonal on the two groups and its
@@ -48,16 +48,16 @@ def test_symmetric_response_splits_with_the_same_spectrum_and_verdicts(make, eve
     n_unstable = 0
     for stable, J, M, C, basis, w in hill_systems(make(), every):
         A = spath.hill_matrix(J, M, C, basis, w)
-        groups = spath.parity_groups(A, basis, M.shape[0])
-        assert groups is not None
-        assert sum(g.size for g in groups) == A.shape[0]
+        blocks = spath.hill_blocks(J, M, C, basis, w)
+        assert len(blocks) == 2
+        assert sum(B.shape[0] for B in blocks) == A.shape[0]
         whole = sla.eigvals(A)
-        split = np.concatenate([sla.eigvals(A[np.ix_(g, g)]) for g in groups])
+        split = np.concatenate([sla.eigvals(B) for B in blocks])
         dist = np.abs(whole[:, None] - split[None, :])
         rows, cols = linear_sum_assignment(dist)           # pair them one to one
         assert dist[rows, cols].max() <= 1e-9 * np.abs(whole).max()
         verdict, margin = spath.hill_margin(J, M, C, basis, w)
-        monkeypatch.setattr(spath, "parity_groups", lambda *args, **kwargs: None)
+        monkeypatch.setattr(spath, "parity_split", lambda *args, **kwargs: None)
         whole_verdict, whole_margin = spath.hill_margin(J, M, C, basis, w)
         monkeypatch.undo()
         assert verdict == whole_verdict == stable
@@ -75,15 +75,36 @@ def test_an_asymmetric_law_couples_the_parities_and_is_not_split():
         "excitation": {"dofs": [0], "amplitude": [0.2]},
         "analysis": {"harmonics": 5, "time_samples": 64, "frequency_hz": [0.14, 0.2],
                      "outputs": {"x": 0}}})
-    split = [spath.parity_groups(spath.hill_matrix(J, M, C, basis, w), basis, M.shape[0])
-             for _, J, M, C, basis, w in hill_systems(case, 5)]
-    assert all(g is None for g in split)
+    for _, J, M, C, basis, w in hill_systems(case, 5):
+        assert spath.parity_split(basis, M.shape[0]) is not None
+        blocks = spath.hill_blocks(J, M, C, basis, w)
+        assert len(blocks) == 1 and np.array_equal(blocks[0], spath.hill_matrix(J, M, C, basis, w))
 
 
 @pytest.mark.parametrize("h", [[1, 3, 5], [0, 2, 4]])
 def test_one_parity_only_is_not_split(h):
     from hbm.balance.fourier import FourierBasis
     basis = FourierBasis(h, 16)
-    n = 2
-    A = np.eye(2 * basis.n_coef * n)
-    assert spath.parity_groups(A, basis, n) is None
+    assert spath.parity_split(basis, 2) is None
+
+
+def test_blocks_of_a_non_modal_mass_hold_the_whole_spectrum():
+    """With a full mass matrix the coupling is ``M^{-1} J``'s; a Jacobian without even-odd
+    coupling splits, and the blocks hold the whole matrix's eigenvalues; one coupling entry
+    above the bound keeps it whole."""
+    from hbm.balance.fourier import FourierBasis
+    rng = np.random.default_rng(3)
+    basis, n, w = FourierBasis([0, 1, 2, 3], 16), 2, 1.3
+    B = rng.standard_normal((n, n))
+    M, C = B @ B.T + n * np.eye(n), 0.1 * np.eye(n)
+    odd = np.repeat(basis.h_of_row, n) % 2 == 1
+    J = rng.standard_normal((odd.size, odd.size)) * (odd[:, None] == odd[None, :])
+    blocks = spath.hill_blocks(J, M, C, basis, w)
+    assert len(blocks) == 2
+    whole = sla.eigvals(spath.hill_matrix(J, M, C, basis, w))
+    split = np.concatenate([sla.eigvals(b) for b in blocks])
+    dist = np.abs(whole[:, None] - split[None, :])
+    rows, cols = linear_sum_assignment(dist)
+    assert dist[rows, cols].max() <= 1e-9 * np.abs(whole).max()
+    J[0, np.flatnonzero(odd)[0]] = 1e-6
+    assert len(spath.hill_blocks(J, M, C, basis, w)) == 1

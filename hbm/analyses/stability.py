@@ -153,29 +153,34 @@ def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis
     Returns
     -------
     A : ndarray, shape (2 n_u, 2 n_u)
-        ``[[0, I], [-D2^{-1} J, -D2^{-1} D1]]``, filled block by block through a 6-D view
-        (no loop over harmonics).
+        ``[[0, I], [-D2^{-1} J, -D2^{-1} D1]]``, filled by blocks and index arrays (no loop
+        over harmonics).
     """
     n = M.shape[0]
     nc = basis.n_coef
     nu = nc * n
     if J.shape != (nu, nu):
         raise ValueError(f"J must be ({nu}, {nu}) for {nc} coefficients x {n} dofs, got {J.shape}")
-    Minv = np.linalg.inv(M)
-    MinvC = Minv @ C
     A = np.zeros((2 * nu, 2 * nu))
-    A6 = A.reshape(2, nc, n, 2, nc, n)
-    r = np.arange(nc)
-    A6[0, r, :, 1, r, :] = np.eye(n)
-    # -D2^{-1} J: M^{-1} applied to every coefficient row-block of J
-    A6[1, :, :, 0, :, :] = -np.einsum("ab,kbl->kal", Minv, J.reshape(nc, n, nu)).reshape(nc, n, nc, n)
+    A[:nu, nu:].flat[::nu + 1] = 1.0
+    if np.array_equal(M, np.eye(n)):          # modal Hill systems: no inverse, no product
+        A[nu:, :nu] = -J
+        MinvC = C
+    else:
+        # -D2^{-1} J: M^{-1} applied to every coefficient row-block of J
+        Minv = np.linalg.inv(M)
+        MinvC = Minv @ C
+        A[nu:, :nu] = -np.einsum("ab,kbl->kal", Minv, J.reshape(nc, n, nu)).reshape(nu, nu)
     # -D2^{-1} D1, block diagonal per harmonic: -M^{-1} C on the diagonal, -+2 h w I coupling
-    A6[1, r, :, 1, r, :] = -MinvC
+    r = np.arange(nc)
+    A.reshape(2, nc, n, 2, nc, n)[1, r, :, 1, r, :] = -MinvC
     rc, h, _ = _pair_rows(basis)
     if rc.size:
-        g = (2.0 * w * h)[:, None, None] * np.eye(n)[None]
-        A6[1, rc, :, 1, rc + 1, :] = -g
-        A6[1, rc + 1, :, 1, rc, :] = g
+        D1 = A[nu:, nu:]
+        rows = (rc[:, None] * n + np.arange(n)).ravel()
+        g = np.repeat(2.0 * w * h, n)
+        D1[rows, rows + n] = -g
+        D1[rows + n, rows] = g
     return A
 
 

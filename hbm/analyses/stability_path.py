@@ -30,6 +30,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from hbm.analyses.stability import StabilityOptions, hill_matrix, hill_stability, verdict_from_eigenvalues
+from hbm.balance.fourier import FourierBasis
 
 PARITY_TOL = 1e-11      # even-odd couplings below this (relative to A) are round-off
 
@@ -56,15 +57,10 @@ def hill_margin(J, M, C, basis, w: float, options: StabilityOptions | None = Non
     opts = options or StabilityOptions()
     if M.shape[0] == 0:
         return True, -np.inf
-    A = hill_matrix(J, M, C, basis, w)
-    if not np.all(np.isfinite(A)):
+    if not np.all(np.isfinite(J)):
         raise ValueError("Hill matrix is not finite (a non-finite Jacobian at a converged point)")
     n = M.shape[0]
-    groups = parity_groups(A, basis, n)
-    if groups is None:
-        lam = eigenvalues(A)
-    else:
-        lam = np.concatenate([eigenvalues(A[np.ix_(g, g)]) for g in groups])
+    lam = np.concatenate([eigenvalues(A) for A in hill_blocks(J, M, C, basis, w)])
     verdict = verdict_from_eigenvalues(lam, n, w, opts.rel_tol)
     if verdict is None:
         res = hill_stability(J, M, C, basis, w, opts)
@@ -90,37 +86,79 @@ def eigenvalues(A: np.ndarray) -> np.ndarray:
 _geev = sla.get_lapack_funcs("geev", dtype=np.float64)
 
 
-def parity_groups(A: np.ndarray, basis, n: int, rel_tol: float = PARITY_TOL):
-    """Rows of the Hill matrix ``A`` on even and on odd harmonics, when they do not couple.
+def hill_blocks(J, M, C, basis, w: float, rel_tol: float = PARITY_TOL) -> list:
+    """Hill's matrix (:func:`hbm.analyses.stability.hill_matrix`) as the blocks whose spectra
+    make up its spectrum: its even and its odd harmonics when they do not couple, else whole.
 
     A half-wave symmetric response (``q(t + T/2) = -q(t)``: symmetric laws, no static
     offset) has a Jacobian with period ``T/2``, which couples a perturbation's harmonic ``j``
-    only to harmonics ``j +- 2k``: ``A`` is block diagonal on the even and the odd rows, and
-    its spectrum is the union of the two blocks' (two eigenproblems of about half the size,
-    about a quarter of the work).  The blocks are used when every coupling entry is below
-    ``rel_tol`` times the largest entry of ``A``.
+    only to harmonics ``j +- 2k``: the Hill matrix is block diagonal on the even and the odd
+    rows (two eigenproblems of about half the size, about a quarter of the work).  ``M`` and
+    ``D1`` act within a harmonic, so the coupling is ``M^{-1} J``'s between the parities; the
+    blocks are used when every coupling entry is below ``rel_tol`` times the largest entry of
+    the Hill matrix.  Each block is built from its own rows of ``J`` on the basis of its
+    harmonics (the whole matrix is never formed).
 
     Parameters
     ----------
-    A : ndarray, shape (2 n_u, 2 n_u)
-        :func:`hbm.analyses.stability.hill_matrix` (layout ``[P; lambda P]``, harmonic-major).
+    J : ndarray, shape (n_u, n_u)
+    M, C : ndarray, shape (n, n)
     basis : FourierBasis
-    n : int
+    w : float
 
     Returns
     -------
-    tuple of 2 ndarrays of int, or None
-        Row indices of the even and the odd group; None when the basis has one parity only
-        or the groups couple.
+    list of ndarray
+        One (2 n_u, 2 n_u) matrix, or the even and the odd block.
     """
-    odd = (np.tile(np.repeat(basis.h_of_row, n), 2) % 2).astype(bool)
-    if odd.all() or not odd.any():
-        return None
-    ev, od = np.flatnonzero(~odd), np.flatnonzero(odd)
-    bound = rel_tol * np.abs(A).max()
-    if np.abs(A[np.ix_(ev, od)]).max() > bound or np.abs(A[np.ix_(od, ev)]).max() > bound:
-        return None
-    return ev, od
+    n = M.shape[0]
+    split = parity_split(basis, n)
+    if split is None:
+        return [hill_matrix(J, M, C, basis, w)]
+    perm, ne, bases = split
+    Jp = J[np.ix_(perm, perm)]
+    if _is_identity(M):
+        MJ, MC = Jp, C
+    else:
+        Minv = np.linalg.inv(M)
+        MJ = np.einsum("ab,kbl->kal", Minv, Jp.reshape(-1, n, Jp.shape[1])).reshape(Jp.shape)
+        MC = Minv @ C
+    largest = max(1.0, np.abs(MJ).max(initial=0.0), np.abs(MC).max(initial=0.0), 2.0 * w * max(basis.harmonics))
+    bound = rel_tol * largest
+    if np.abs(MJ[:ne, ne:]).max() > bound or np.abs(MJ[ne:, :ne]).max() > bound:
+        return [hill_matrix(J, M, C, basis, w)]
+    return [hill_matrix(Jp[:ne, :ne], M, C, bases[0], w), hill_matrix(Jp[ne:, ne:], M, C, bases[1], w)]
+
+
+def _is_identity(M: np.ndarray) -> bool:
+    return bool(np.array_equal(M, np.eye(M.shape[0])))
+
+
+_SPLITS: dict = {}
+
+
+def parity_split(basis, n: int):
+    """The even and odd harmonics of ``basis`` as a permutation of the Jacobian's rows.
+
+    Returns
+    -------
+    tuple or None
+        ``(perm, n_even, (even_basis, odd_basis))``: ``perm`` (n_u,) lists the rows of the
+        even harmonics (harmonic-major, ``n`` per coefficient) and then the odd ones,
+        ``n_even`` of them even; None when the basis has one parity only.
+    """
+    key = (tuple(int(h) for h in basis.harmonics), int(basis.n_samples), int(n))
+    if key not in _SPLITS:
+        odd = (np.repeat(basis.h_of_row, n) % 2).astype(bool)
+        hs = [int(h) for h in basis.harmonics]
+        if odd.all() or not odd.any():
+            _SPLITS[key] = None
+        else:
+            ev, od = np.flatnonzero(~odd), np.flatnonzero(odd)
+            bases = (FourierBasis([h for h in hs if h % 2 == 0], basis.n_samples),
+                     FourierBasis([h for h in hs if h % 2 == 1], basis.n_samples))
+            _SPLITS[key] = (np.r_[ev, od], ev.size, bases)
+    return _SPLITS[key]
 
 
 def _skip(margins: dict, i: int, max_skip: int) -> int:
