@@ -108,3 +108,19 @@ def test_blocks_of_a_non_modal_mass_hold_the_whole_spectrum():
     assert dist[rows, cols].max() <= 1e-9 * np.abs(whole).max()
     J[0, np.flatnonzero(odd)[0]] = 1e-6
     assert len(spath.hill_blocks(J, M, C, basis, w)) == 1
+
+
+def test_one_harmonic_splits_into_the_mean_and_the_first_harmonic():
+    """H = 1 (harmonics 0 and 1): the even block holds the mean alone; the two blocks hold the
+    whole matrix's eigenvalues (the stress matrix's H = 1 cases raised here once)."""
+    from hbm.balance.fourier import FourierBasis
+    rng = np.random.default_rng(5)
+    basis, n, w = FourierBasis([0, 1], 8), 3, 0.7
+    odd = np.repeat(basis.h_of_row, n) % 2 == 1
+    J = rng.standard_normal((odd.size, odd.size)) * (odd[:, None] == odd[None, :])
+    M, C = np.eye(n), 0.05 * np.eye(n)
+    blocks = spath.hill_blocks(J, M, C, basis, w)
+    assert [b.shape[0] for b in blocks] == [2 * n, 4 * n]
+    whole = np.sort_complex(sla.eigvals(spath.hill_matrix(J, M, C, basis, w)))
+    split = np.sort_complex(np.concatenate([sla.eigvals(b) for b in blocks]))
+    assert np.allclose(whole, split, rtol=0, atol=1e-10 * np.abs(whole).max())

@@ -26,11 +26,12 @@ every point; a larger skip is an explicit trade of certainty for time.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import scipy.linalg as sla
 
 from hbm.analyses.stability import StabilityOptions, hill_matrix, hill_stability, verdict_from_eigenvalues
-from hbm.balance.fourier import FourierBasis
 
 PARITY_TOL = 1e-11      # even-odd couplings below this (relative to A) are round-off
 
@@ -137,26 +138,36 @@ def _is_identity(M: np.ndarray) -> bool:
 _SPLITS: dict = {}
 
 
+@dataclasses.dataclass(frozen=True)
+class _Rows:
+    """The coefficient rows of one parity, as :func:`hill_matrix` reads a basis (the even
+    ones may hold the mean alone, which no :class:`FourierBasis` does)."""
+    h_of_row: np.ndarray
+
+    @property
+    def n_coef(self) -> int:
+        return int(self.h_of_row.size)
+
+
 def parity_split(basis, n: int):
     """The even and odd harmonics of ``basis`` as a permutation of the Jacobian's rows.
 
     Returns
     -------
     tuple or None
-        ``(perm, n_even, (even_basis, odd_basis))``: ``perm`` (n_u,) lists the rows of the
+        ``(perm, n_even, (even_rows, odd_rows))``: ``perm`` (n_u,) lists the rows of the
         even harmonics (harmonic-major, ``n`` per coefficient) and then the odd ones,
         ``n_even`` of them even; None when the basis has one parity only.
     """
     key = (tuple(int(h) for h in basis.harmonics), int(basis.n_samples), int(n))
     if key not in _SPLITS:
         odd = (np.repeat(basis.h_of_row, n) % 2).astype(bool)
-        hs = [int(h) for h in basis.harmonics]
         if odd.all() or not odd.any():
             _SPLITS[key] = None
         else:
             ev, od = np.flatnonzero(~odd), np.flatnonzero(odd)
-            bases = (FourierBasis([h for h in hs if h % 2 == 0], basis.n_samples),
-                     FourierBasis([h for h in hs if h % 2 == 1], basis.n_samples))
+            hr = basis.h_of_row
+            bases = (_Rows(hr[hr % 2 == 0]), _Rows(hr[hr % 2 == 1]))
             _SPLITS[key] = (np.r_[ev, od], ev.size, bases)
     return _SPLITS[key]
 
