@@ -249,11 +249,56 @@ def test_runs_of_unstable_points_are_confirmed_by_their_middle(monkeypatch):
     Xs = np.zeros((20, 3, case.n_dof))
     st = {}
     out = fc.confirm_unstable(case, None, Xs, freq, stable, st)
-    assert asked == [9.0, 13.0, 12.0, 14.0, 4.0]                # shortest first; 12-14 turned, so all of it
+    # shortest first (the first at 256 and 1024 steps: they agree); 12-14 turned, so all of it
+    assert asked == [9.0, 9.0, 13.0, 12.0, 14.0, 4.0]
     assert list(np.flatnonzero(~out)) == [2, 3, 4, 5, 6, 14]
-    assert st == {"floquet_checked": 5, "floquet_overrides_hz": [9.0, 12.0, 13.0]}
+    assert st == {"floquet_checked": 5, "floquet_steps": 256, "floquet_overrides_hz": [9.0, 12.0, 13.0]}
     monkeypatch.setattr(fc, "MAX_CONFIRM", 3)
     asked.clear()
     st = {}
     out = fc.confirm_unstable(case, None, Xs, freq, stable, st)
-    assert asked == [9.0, 13.0, 12.0] and st["floquet_unchecked"] == 1 + 5     # 14, and the run 2-6
+    assert asked == [9.0, 9.0, 13.0, 12.0] and st["floquet_unchecked"] == 1 + 5     # 14, and the run 2-6
+
+
+def test_a_long_run_is_sampled_and_its_stable_window_bisected(monkeypatch):
+    """A run longer than LONG_RUN (the railcar's Hill-unstable 35.8-37 Hz holds a window that
+    Floquet calls stable) is checked at RUN_SAMPLES points; each change of verdict between two
+    samples is bisected to neighbouring points, and the window between is turned stable."""
+    from hbm.timedomain import floquet_check as fc
+    case = duffing_chain("full")
+    n = 60
+    freq = np.arange(float(n))
+    stable = np.ones(n, dtype=bool)
+    stable[5:55] = False                                        # one run of 50 points
+    truly_stable = set(range(21, 33))                           # Floquet's stable window
+    asked = []
+
+    def fake(case, basis, X, f, steps, problem):
+        asked.append(int(f))
+        return fc.FloquetCheck(int(f) in truly_stable, 1.0, True, 0.0, "", {}, {}, 1)
+    monkeypatch.setattr(fc, "check_point", fake)
+    st = {}
+    out = fc.confirm_unstable(case, None, np.zeros((n, 3, case.n_dof)), freq, stable, st)
+    assert list(np.flatnonzero(out[5:55]) + 5) == sorted(truly_stable)
+    assert st["floquet_checked"] == len(asked) - 1 < 9 + 2 * 3   # samples + two bisections of <= 3 steps
+    assert st["floquet_overrides_hz"] == [float(i) for i in sorted(truly_stable)]
+
+
+def test_the_checks_take_finer_steps_when_the_first_disagrees_between_step_counts(monkeypatch):
+    """The first check runs at 256 and 1024 steps; multipliers more than 2 % apart (the railcar
+    rig: 1.06 against 0.94 at 36.475 Hz) make every check of the FRF take 1024 steps."""
+    from hbm.timedomain import floquet_check as fc
+    case = duffing_chain("full")
+    freq = np.arange(10.0)
+    stable = np.ones(10, dtype=bool)
+    stable[[2, 6, 7]] = False
+    asked = []
+
+    def fake(case, basis, X, f, steps, problem):
+        asked.append((int(f), steps))
+        return fc.FloquetCheck(steps > 256, 1.06 if steps == 256 else 0.94, True, 0.0, "", {}, {}, 1)
+    monkeypatch.setattr(fc, "check_point", fake)
+    st = {}
+    out = fc.confirm_unstable(case, None, np.zeros((10, 3, case.n_dof)), freq, stable, st)
+    assert asked == [(2, 256), (2, 1024), (7, 1024), (6, 1024)] and st["floquet_steps"] == 1024
+    assert out.all() and st["floquet_overrides_hz"] == [2.0, 6.0, 7.0]

@@ -158,16 +158,18 @@ def test_floquet_check_agrees_with_hill_on_the_duffing_branches():
 
 def test_floquet_confirmation_keeps_true_instability_and_clears_a_false_flag():
     """With a non-smooth law in the model (a Jenkins element that never slips) the FRF checks
-    Hill's unstable points by Floquet: the Duffing middle branch stays unstable (its middle
-    point is checked and confirms the run); a stable point flagged unstable by hand is
-    cleared and reported."""
+    Hill's unstable points by Floquet: the Duffing middle branch stays unstable (a short run's
+    middle point, a long run's samples, are checked and confirm it); a stable point flagged
+    unstable by hand is cleared and reported."""
     import hbm
     from hbm.timedomain.floquet_check import confirm_unstable
     case = duffing([{"type": "jenkins", "dofs": [0], "kt": 0.2, "slip_force": 1e6}])
     res = hbm.frf(case)
+    from hbm.timedomain.floquet_check import LONG_RUN, RUN_SAMPLES
     bad = np.flatnonzero(~res.stable)
-    runs = 1 + int(np.count_nonzero(np.diff(bad) > 1))
-    assert bad.size > 10 and res.settings["floquet_checked"] == runs       # each run's middle confirms it
+    runs = np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)
+    samples = sum(1 if r.size <= LONG_RUN else RUN_SAMPLES for r in runs)
+    assert bad.size > 10 and res.settings["floquet_checked"] == samples    # each run's samples confirm it
     assert "floquet_overrides_hz" not in res.settings
     fake = res.stable.copy()
     k = int(np.flatnonzero(res.stable)[3])
