@@ -136,10 +136,15 @@ def _simulate(case, f: float, seconds: float, why: str) -> dict:
         r = timesim(case, f, progress=watch)
     except (RuntimeError, CaseError, _OutOfTime) as exc:      # a failed or refused integration
         return {"freq_hz": f, "ok": False, "message": str(exc), "seconds": time.perf_counter() - t0}
-    return {"freq_hz": f, "ok": bool(r.converged), "h1": dict(r.h1), "max": dict(r.max),
-            "error_estimate": float(r.error_estimate), "periods": int(r.periods),
-            "seconds": time.perf_counter() - t0,
-            "message": "" if r.converged else f"not periodic to tolerance after {r.periods} periods"}
+    rec = {"freq_hz": f, "ok": bool(r.converged), "h1": dict(r.h1), "max": dict(r.max),
+           "error_estimate": float(r.error_estimate), "periods": int(r.periods),
+           "seconds": time.perf_counter() - t0,
+           "message": "" if r.converged else f"not periodic to tolerance after {r.periods} periods"}
+    if r.converged and r.shot_unstable is not None:       # a periodic solution, not a settled motion
+        rec.update(stable=False, largest_multiplier=r.shot_unstable,
+                   message=f"found by shooting, unstable by Floquet (largest |multiplier| {r.shot_unstable:.4g}): "
+                           f"a motion from rest leaves it")
+    return rec
 
 
 def spread_order(n: int) -> list:
@@ -324,6 +329,11 @@ def fill_note(record: dict, harmonics) -> str:
             f"time-domain points (hbm timesim, {record['seconds']:.1f} s) in frf_timedomain.csv")
     if ok:
         note += f", estimated error up to {max(p['error_estimate'] for p in ok):.1e}"
+    shaky = [p for p in ok if p["kind"] != "check" and p.get("stable") is False]
+    if shaky:
+        at = ", ".join(f"{p['freq_hz']:.6g}" for p in shaky[:3])
+        note += (f" ({len(shaky)} of them found by shooting and unstable by Floquet, at {at} Hz: periodic "
+                 f"solutions a motion from rest leaves)")
     off = [p["hbm_off"] for p in checks if p["ok"]]
     if off:
         span = f"{100 * min(off):.2g}" + ("" if len(off) == 1 else f"-{100 * max(off):.2g}")

@@ -258,6 +258,11 @@ def cmd_timesim(args) -> int:
         verdict = "UNSTABLE" if not res.floquet[0] else (
             "stable (neutral multipliers of 1: a contact stuck all period)" if res.floquet[1] > 1 - 1e-9 else "stable")
         print(f"  Floquet: largest |multiplier| {res.floquet[1]:.6f}: {verdict}")
+    if res.shot_unstable is not None:
+        sys.stderr.write(f"hbm: timesim: warning: the periodic solution was found by shooting and is UNSTABLE "
+                         f"(largest |Floquet multiplier| {res.shot_unstable:.4g}): a motion from rest leaves it "
+                         f"(its plain periods did not repeat), so it is not what the structure shows; "
+                         f"--shoot-after {max(10 * opts.shoot_after, 2000)} integrates longer before shooting\n")
     print(f"  wrote {args.out}/timesim.csv, history.csv, timesim.png")
     if not res.converged:
         sys.stderr.write(f"hbm: timesim: no periodic steady state within {opts.max_periods} periods "

@@ -163,6 +163,21 @@ class TimeSimResult:
     def history(self) -> History:
         return self.fine.history
 
+    @property
+    def shot_unstable(self) -> float | None:
+        """Largest ``|multiplier|`` when the steady state was found by shooting and its
+        monodromy matrix calls it unstable, else None.  Newton on the period map converges to
+        unstable periodic solutions too: a motion from rest leaves such a one (its plain
+        periods had not repeated), so it is not what the structure would show.  (The
+        multipliers are the last shooting iteration's, free with the orbit.)"""
+        from hbm.timedomain.shooting import floquet_verdict
+        shot = next((r.shooting for r in (self.fine, self.coarse)
+                     if r.shooting is not None and r.shooting.converged), None)
+        if shot is None:
+            return None
+        stable, big = floquet_verdict(shot.multipliers)
+        return None if stable else big
+
 
 def output_series(case, q: np.ndarray, t: np.ndarray, w: float) -> dict:
     """Each output's values ``y = q g`` (n_rows,) at the rows of ``q`` (n_rows, n), times ``t``;
