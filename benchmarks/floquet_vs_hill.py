@@ -113,6 +113,10 @@ def from_rest(name, case, res, freqs, steps):
     bad = 0
     for fq in freqs:
         run = steady_state(model, fq, TimeSimOptions(steps=steps))
+        if run.shot_unstable is not None:          # shooting found an orbit a motion from rest leaves
+            print(f"   from rest at {fq:g} Hz: no settled motion; shooting found a periodic solution that is "
+                  f"unstable by Floquet (largest |multiplier| {run.shot_unstable:.4g}): not compared")
+            continue
         cross = np.flatnonzero((f[:-1] - fq) * (f[1:] - fq) <= 0)
         amps = [a[i] + (a[i + 1] - a[i]) * (fq - f[i]) / (f[i + 1] - f[i]) if f[i + 1] != f[i] else a[i]
                 for i in cross]

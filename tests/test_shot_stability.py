@@ -23,6 +23,7 @@ def result(multipliers, converged=True, names=("x",)):
 
 def test_unstable_multipliers_of_a_shot_orbit_are_reported():
     assert result([1.34, 0.2 + 0.1j]).shot_unstable == 1.34
+    assert result([1.34, 0.2 + 0.1j]).fine.shot_unstable == 1.34
     assert result([0.9, 0.2 + 0.1j]).shot_unstable is None             # stable: nothing to say
     assert result([1.34], converged=False).shot_unstable is None      # no orbit found
 

@@ -121,6 +121,19 @@ class Run:
     seconds: float
     shooting: object = None
 
+    @property
+    def shot_unstable(self) -> float | None:
+        """Largest ``|multiplier|`` when this run's steady state was found by shooting and its
+        monodromy matrix calls it unstable, else None.  Newton on the period map converges to
+        unstable periodic solutions too: a motion from rest leaves such a one (its plain
+        periods had not repeated), so it is not what the structure would show.  (The
+        multipliers are the last shooting iteration's, free with the orbit.)"""
+        from hbm.timedomain.shooting import floquet_verdict
+        if self.shooting is None or not self.shooting.converged:
+            return None
+        stable, big = floquet_verdict(self.shooting.multipliers)
+        return None if stable else big
+
 
 @dataclass(frozen=True)
 class TimeSimResult:
@@ -165,18 +178,9 @@ class TimeSimResult:
 
     @property
     def shot_unstable(self) -> float | None:
-        """Largest ``|multiplier|`` when the steady state was found by shooting and its
-        monodromy matrix calls it unstable, else None.  Newton on the period map converges to
-        unstable periodic solutions too: a motion from rest leaves such a one (its plain
-        periods had not repeated), so it is not what the structure would show.  (The
-        multipliers are the last shooting iteration's, free with the orbit.)"""
-        from hbm.timedomain.shooting import floquet_verdict
-        shot = next((r.shooting for r in (self.fine, self.coarse)
+        """:attr:`Run.shot_unstable` of the fine run, else of the coarse one."""
+        return next((r.shot_unstable for r in (self.fine, self.coarse)
                      if r.shooting is not None and r.shooting.converged), None)
-        if shot is None:
-            return None
-        stable, big = floquet_verdict(shot.multipliers)
-        return None if stable else big
 
 
 def output_series(case, q: np.ndarray, t: np.ndarray, w: float) -> dict:
