@@ -254,6 +254,7 @@ def test_runs_of_unstable_points_are_confirmed_by_their_middle(monkeypatch):
     assert list(np.flatnonzero(~out)) == [2, 3, 4, 5, 6, 14]
     assert st == {"floquet_checked": 5, "floquet_steps": 256, "floquet_overrides_hz": [9.0, 12.0, 13.0]}
     monkeypatch.setattr(fc, "MAX_CONFIRM", 3)
+    monkeypatch.setattr(fc, "CONFIRM_SECONDS", 0.0)
     asked.clear()
     st = {}
     out = fc.confirm_unstable(case, None, Xs, freq, stable, st)

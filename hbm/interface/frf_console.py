@@ -66,7 +66,7 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
               f"time-domain period map (at {', '.join(f'{f:.6g}' for f in fl[:5])} Hz); the verdicts are Floquet's")
     if st.get("floquet_unchecked"):
         print(f"  note: {st['floquet_unchecked']} point(s) Hill calls unstable were not checked by Floquet "
-              f"multipliers (the checks stop at 40 per FRF): their verdicts are Hill's")
+              f"multipliers (the checks stop past 40 and 30 s per FRF): their verdicts are Hill's")
     if st.get("stuck_points"):
         print(f"  note: at {st['stuck_points']} points a contact sticks for the whole period: its slider offset, "
               f"hence the mean and max |y|, is one of a family of periodic solutions (column stuck_contacts)")

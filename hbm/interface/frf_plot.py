@@ -69,16 +69,21 @@ def _draw_jumps(ax, jumps, scale):
 
 def _draw_fill(ax, points, names, colours, scale):
     """Time-domain points (:mod:`hbm.analyses.time_fill`: untraced stretches, far-off points):
-    per output the first harmonic (filled diamonds) and max (open diamonds), where they settled."""
+    per output the first harmonic (filled diamonds) and max (open diamonds), where they settled;
+    periodic solutions that shooting found and Floquet calls unstable as crosses (a motion from
+    rest leaves them)."""
     ok = [p for p in points if p["ok"]]
-    if not ok:
-        return
-    f = [p["freq_hz"] for p in ok]
-    for k, name in enumerate(names):
-        c = colours[k % len(colours)]
-        ax.plot(f, [p["h1"][name] / scale for p in ok], "D", ms=4, color=c)
-        ax.plot(f, [p["max"][name] / scale for p in ok], "D", ms=4, mfc="none", color=c)
-    ax.plot([], [], "D", ms=4, color="0.3", label="time domain (untraced, or HBM far off)")
+    for unstable, marker, label in ((False, "D", "time domain (untraced, or HBM far off)"),
+                                    (True, "x", "time domain: periodic, unstable (shooting)")):
+        some = [p for p in ok if (p.get("stable") is False) == unstable]
+        if not some:
+            continue
+        f = [p["freq_hz"] for p in some]
+        for k, name in enumerate(names):
+            c = colours[k % len(colours)]
+            ax.plot(f, [p["h1"][name] / scale for p in some], marker, ms=4, color=c)
+            ax.plot(f, [p["max"][name] / scale for p in some], marker, ms=4, mfc="none", color=c, alpha=0.6)
+        ax.plot([], [], marker, ms=4, color="0.3", label=label)
 
 
 def _draw_errors(ax, freq, errs, colours, tol=None):
