@@ -28,20 +28,27 @@ RETRY_SECONDS = 60.0        # a first run longer than this is not repeated (its 
 SHARE = 0.9                 # the events run is kept if it leaves at most this share untraced
 
 
-def stiff_sampled_contacts(case) -> list:
-    """``(index, kt / k_structure)`` of the elements that offer ``aft = "events"``, are sampled
-    and are stiff (module doc), on the full or the condensed solver (the structure's
-    stiffness matrix as given, dense or sparse)."""
+def stiff_contacts(case) -> list:
+    """``(index, kt / k_structure)`` of the elements with a contact stiffness ``kt`` at least
+    ``STIFF_CONTACT`` times the structure's stiffness along their first coordinate, on the full
+    or the condensed solver (the structure's stiffness matrix as given, dense or sparse)."""
     K = case.structure.K
     out = []
     for i, e in enumerate(case.elements):
-        if not e.events_available or e.aft != "sampled":
+        kt = getattr(e, "kt", None)
+        if kt is None:
             continue
         g = np.asarray(e.gather[0], dtype=float)
         ks = float(g @ (K @ g)) / float(g @ g)
-        if ks > 0 and e.kt >= STIFF_CONTACT * ks:
-            out.append((i, e.kt / ks))
+        if ks > 0 and kt >= STIFF_CONTACT * ks:
+            out.append((i, kt / ks))
     return out
+
+
+def stiff_sampled_contacts(case) -> list:
+    """:func:`stiff_contacts` that offer ``aft = "events"`` and are sampled (module doc)."""
+    return [(i, r) for i, r in stiff_contacts(case)
+            if case.elements[i].events_available and case.elements[i].aft == "sampled"]
 
 
 def untraced_hz(res) -> float:

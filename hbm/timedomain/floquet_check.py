@@ -22,6 +22,7 @@ import numpy as np
 
 from elements.kernels import law_init, law_step
 
+from hbm.analyses.aft_retry import stiff_contacts
 from hbm.balance.fourier import FourierBasis, basis_matrix
 from hbm.timedomain.condensed_twin import time_model
 from hbm.timedomain.shooting import floquet_verdict, set_state, shoot
@@ -156,8 +157,7 @@ MAX_CONFIRM = 40            # Hill-unstable points checked per FRF at least, if 
 CONFIRM_SECONDS = 30.0      # and more while the checks have taken less than this
 MAX_STATE = 400             # 3 n + n_S above which the check is not run (cost ~ m n^2 per step)
 CONFIRM_STEPS = 256         # the FRF's own checks: the verdicts of 1024 steps at a quarter of the cost
-FINE_STEPS = 1024           # ... unless the first check's multipliers at 256 and 1024 steps differ
-STEPS_AGREE = 0.02          # by more than this (relative)
+FINE_STEPS = 1024           # ... on models with stiff contacts (hbm.analyses.aft_retry.stiff_contacts)
 LONG_RUN = 8                # runs of more unstable points are sampled, not judged by their middle
 RUN_SAMPLES = 9             # checks spread over a long run (then its verdict changes bisected)
 
@@ -192,12 +192,12 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     The checks take ``CONFIRM_STEPS`` steps per period: at 25 points of ``upd_like``, 24 of
     the UPD flanks rig's (unstable ones included) and the blade couple's overridden point the
     verdicts of 256 steps are those of 1024 wherever both converged, the largest multipliers
-    1e-5 apart on stable points and up to 2 % on unstable ones.  Not so on the railcar rig
-    (stiff contacts whose stick events 256 steps do not resolve): there 256 steps gave the
-    opposite verdict at 20 of 24 points of 36.38-36.81 Hz, where 1024 and 4096 steps agree.
-    So the first check runs at both (:func:`_calibrated`): when their largest multipliers
-    differ by more than ``STEPS_AGREE`` the FRF's checks take ``FINE_STEPS``
-    (``settings["floquet_steps"]``).
+    1e-5 apart on stable points and up to 2 % on unstable ones.  Not so on the railcar rig,
+    whose contacts are 112-338 times stiffer than the structure along them: there 256 steps
+    gave the opposite verdict at 20 of 24 points of 36.38-36.81 Hz, where 1024 and 4096 steps
+    agree (and the same verdict at a point of 28-30 Hz, so one trial check does not tell).  A
+    model with stiff contacts (:func:`hbm.analyses.aft_retry.stiff_contacts`, at least 100
+    times) is checked at ``FINE_STEPS`` (``settings["floquet_steps"]``).
 
     Parameters
     ----------
@@ -221,6 +221,7 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     out = stable.copy()
     turned, checks, unchecked = [], 0, 0
     t0 = time.perf_counter()
+    steps = settings["floquet_steps"] = FINE_STEPS if stiff_contacts(case) else CONFIRM_STEPS
 
     def spent() -> bool:
         return checks >= MAX_CONFIRM and time.perf_counter() - t0 >= CONFIRM_SECONDS
@@ -232,12 +233,7 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
             return None
         checks += 1
 
-        def at(steps):
-            return check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
-        if "floquet_steps" not in settings:
-            c, settings["floquet_steps"] = _calibrated(at)
-        else:
-            c = at(settings["floquet_steps"])
+        c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
         return bool(c.converged and c.stable)
 
     runs = np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)
@@ -263,18 +259,6 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     if turned:
         settings["floquet_overrides_hz"] = sorted(turned)
     return out
-
-
-def _calibrated(at):
-    """The first check at ``CONFIRM_STEPS`` and at ``FINE_STEPS`` steps per period: ``(check,
-    steps)``, the coarse one when both converged with largest multipliers within
-    ``STEPS_AGREE``, else the fine one (the coarse one when only it converged)."""
-    coarse, fine = at(CONFIRM_STEPS), at(FINE_STEPS)
-    if coarse.converged and fine.converged and abs(coarse.largest - fine.largest) <= STEPS_AGREE * max(fine.largest, 1.0):
-        return coarse, CONFIRM_STEPS
-    if fine.converged or not coarse.converged:
-        return fine, FINE_STEPS
-    return coarse, CONFIRM_STEPS
 
 
 def _sampled_run(run: np.ndarray, stable_at) -> set:
