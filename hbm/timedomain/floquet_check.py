@@ -185,7 +185,7 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     calls it stable, every point of the run is checked and a converged Floquet verdict
     replaces Hill's.  A longer run is checked at ``RUN_SAMPLES`` points spread over it
     (:func:`_sampled_run`): on the railcar rig Hill calls 35.8-37 Hz unstable, and Floquet
-    agrees at the middle of that stretch but finds a stable window at 36.45-36.75 Hz
+    agrees at the middle of that stretch but finds a stable window at 36.45-36.72 Hz
     (multipliers 0.69-0.94 at 1024 and 4096 steps alike).  ``settings["floquet_checked"]``
     counts the checks, ``settings["floquet_overrides_hz"]`` lists the points turned stable and
     ``settings["floquet_unchecked"]`` counts the unstable points left unchecked by the cap.
@@ -265,9 +265,9 @@ def _sampled_run(run: np.ndarray, stable_at) -> set:
     """Points of a long unstable run (indices (L,)) that Floquet turns stable.
 
     ``RUN_SAMPLES`` points spread evenly over the run are checked; between two neighbouring
-    samples of the same verdict every point takes it (the multipliers move continuously
-    between stick-slip events, as Hill's exponents do between probes,
-    :mod:`hbm.analyses.stability_path`); where the verdict changes, the change is bisected to
+    samples of the same verdict every point takes it (an assumption, as for Hill's verdicts
+    between probes, :mod:`hbm.analyses.stability_path`: an island narrower than the samples'
+    spacing can be missed); where the verdict changes, the change is bisected to
     neighbouring points.  ``stable_at(i)`` returns True (stable), False, or None (past the cap:
     Hill's verdict stands).
     """
