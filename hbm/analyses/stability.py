@@ -163,7 +163,7 @@ def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis
         raise ValueError(f"J must be ({nu}, {nu}) for {nc} coefficients x {n} dofs, got {J.shape}")
     A = np.zeros((2 * nu, 2 * nu))
     A[:nu, nu:].flat[::nu + 1] = 1.0
-    if np.array_equal(M, np.eye(n)):          # modal Hill systems: no inverse, no product
+    if is_identity(M):                        # modal Hill systems: no inverse, no product
         A[nu:, :nu] = -J
         MinvC = C
     else:
@@ -182,6 +182,11 @@ def hill_matrix(J: np.ndarray, M: np.ndarray, C: np.ndarray, basis: FourierBasis
         D1[rows, rows + n] = -g
         D1[rows + n, rows] = g
     return A
+
+
+def is_identity(M: np.ndarray) -> bool:
+    """Whether the mass matrix ``M`` (n, n) is exactly the identity (mass-normalised modes)."""
+    return bool(np.array_equal(M, np.eye(M.shape[0])))
 
 
 def complex_index_weights(P: np.ndarray, basis: FourierBasis, n: int):

@@ -31,7 +31,8 @@ import dataclasses
 import numpy as np
 import scipy.linalg as sla
 
-from hbm.analyses.stability import StabilityOptions, hill_matrix, hill_stability, verdict_from_eigenvalues
+from hbm.analyses.stability import (StabilityOptions, hill_matrix, hill_stability, is_identity,
+                                   verdict_from_eigenvalues)
 
 PARITY_TOL = 1e-11      # even-odd couplings below this (relative to A) are round-off
 
@@ -118,7 +119,7 @@ def hill_blocks(J, M, C, basis, w: float, rel_tol: float = PARITY_TOL) -> list:
         return [hill_matrix(J, M, C, basis, w)]
     perm, ne, bases = split
     Jp = J[np.ix_(perm, perm)]
-    if _is_identity(M):
+    if is_identity(M):
         MJ, MC = Jp, C
     else:
         Minv = np.linalg.inv(M)
@@ -129,10 +130,6 @@ def hill_blocks(J, M, C, basis, w: float, rel_tol: float = PARITY_TOL) -> list:
     if np.abs(MJ[:ne, ne:]).max() > bound or np.abs(MJ[ne:, :ne]).max() > bound:
         return [hill_matrix(J, M, C, basis, w)]
     return [hill_matrix(Jp[:ne, :ne], M, C, bases[0], w), hill_matrix(Jp[ne:, ne:], M, C, bases[1], w)]
-
-
-def _is_identity(M: np.ndarray) -> bool:
-    return bool(np.array_equal(M, np.eye(M.shape[0])))
 
 
 _SPLITS: dict = {}

@@ -127,7 +127,7 @@ def _restart_past_stops(problem, case, pts, segments, window, xscale, r_scale, o
         back = TracedPoints()
         _trace(problem, case, back, restart[0], restart[1], restart[2], (w_from, w_hi), -1, xscale, r_scale,
                opts, progress, offset=len(pts.w), lam_step=lam_step)
-        pts.extend_reversed(back, skip_first=True)
+        pts.extend(back, skip_first=True, reverse=True)
         w_reached = min(back.w) if back.w else restart[2]
         if w_reached > w_from * (1 + 1e-9):
             gaps.append({"from_hz": w_from / (2 * np.pi), "to_hz": w_reached / (2 * np.pi), "reason": message,
@@ -185,7 +185,7 @@ def _merge_parts(pts, segments, parts, ends, basis) -> list:
     for part, down in sorted(parts, key=lambda pd: (min(pd[0].w), not pd[1])):
         start = len(pts.w)
         if down:
-            pts.extend_reversed(part)
+            pts.extend(part, reverse=True)
         else:                   # traced up from a restart, which the part down from it holds
             pts.extend(part, skip_first=True)
         if len(pts.w) > start:
@@ -333,7 +333,7 @@ def trace_window(problem, case, window, xscale, r_scale, opts, progress, setting
                         f"traced: the branch from {hi:.6g} Hz folded back too")
             status, message = st2, f"{first_msg}: {msg2}"
             segments.append([len(pts.w), len(pts.w) + len(part.w)])
-            pts.extend_reversed(part)
+            pts.extend(part, reverse=True)
     if len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):
         status = "max_steps"
         message = f"stopped after max_points={case.analysis.max_points} points at {pts.w[-1] / (2 * np.pi):.6g} Hz"
@@ -368,7 +368,7 @@ def _from_the_top(problem, case, window, xscale, r_scale, opts, progress, lam_st
             problem, case, window, xscale, r_scale, opts, progress, lam_step, widen=True)
     except RuntimeError as exc:
         return pts, [], ("failed", f"{why}; from {hi:.6g} Hz neither: {exc}", [], 0), xscale
-    pts.extend_reversed(part)
+    pts.extend(part, reverse=True)
     if folded:
         status, message = "failed", f"the branch from {hi:.6g} Hz folded back out of the window at {hi:.6g} Hz"
     elif len(pts.w) >= case.analysis.max_points and status not in ("finished", "failed"):

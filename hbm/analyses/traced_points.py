@@ -15,17 +15,13 @@ class TracedPoints:
     def __init__(self):
         self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
 
-    def extend(self, other: "TracedPoints", skip_first: bool = False) -> None:
-        """Append ``other``'s points in order (without its first point if ``skip_first``)."""
+    def extend(self, other: "TracedPoints", skip_first: bool = False, reverse: bool = False) -> None:
+        """Append ``other``'s points, in order or with ``reverse`` in reverse order (without its
+        first point if ``skip_first``)."""
         k = 1 if skip_first else 0
         for name in self.FIELDS:
-            getattr(self, name).extend(getattr(other, name)[k:])
-
-    def extend_reversed(self, other: "TracedPoints", skip_first: bool = False) -> None:
-        """Append ``other``'s points in reverse order (without its first point if ``skip_first``)."""
-        k = 1 if skip_first else 0
-        for name in self.FIELDS:
-            getattr(self, name).extend(getattr(other, name)[k:][::-1])
+            got = getattr(other, name)[k:]
+            getattr(self, name).extend(got[::-1] if reverse else got)
 
     def passes(self, X: np.ndarray, w: float, rtol: float = ON_PATH) -> bool:
         """Whether ``(X, w)`` lies on the traced path: within ``rtol`` (relative, 2-norm of the
