@@ -1,10 +1,10 @@
 """A run that stops short with stiff sampled contacts is traced again on their exact AFT.
 
 A sampled AFT puts a contact's switches on the time grid: for a stiff contact (``kt`` at
-least ``STIFF_CONTACT`` times the structure's stiffness ``g K g^T / g g^T`` along its first
-coordinate) that is an error Newton cannot average out, and the path may stall there.  The
-elements that offer an event-based AFT (``events_available``: Jenkins, friction3d on (t1, n))
-compute the same law exactly from its events.  So when an FRF with such contacts stops or
+least ``STIFF_CONTACT`` times the structure's stiffness along its first coordinate,
+:mod:`hbm.model.contact_stiffness`) that is an error Newton cannot average out, and the path
+may stall there.  The elements that offer an event-based AFT (``events_available``: Jenkins,
+friction3d on (t1, n)) compute the same law exactly from its events.  So when an FRF with such contacts stops or
 leaves gaps, :func:`retry_with_events` traces the window again with ``aft = "events"`` on
 them and keeps the run that covers more of it: a finished run before a stopped one, then the
 untraced width (gaps, the window's ends a stopped run did not reach, a hole between a
@@ -19,30 +19,12 @@ from __future__ import annotations
 import copy
 import dataclasses
 
-import numpy as np
 
 from hbm.analyses.time_fill import untraced_stretches
+from hbm.model.contact_stiffness import stiff_contacts
 
-STIFF_CONTACT = 100.0       # kt over the structure's stiffness at the contact
 RETRY_SECONDS = 60.0        # a first run longer than this is not repeated (its hint says how)
 SHARE = 0.9                 # the events run is kept if it leaves at most this share untraced
-
-
-def stiff_contacts(case) -> list:
-    """``(index, kt / k_structure)`` of the elements with a contact stiffness ``kt`` at least
-    ``STIFF_CONTACT`` times the structure's stiffness along their first coordinate, on the full
-    or the condensed solver (the structure's stiffness matrix as given, dense or sparse)."""
-    K = case.structure.K
-    out = []
-    for i, e in enumerate(case.elements):
-        kt = getattr(e, "kt", None)
-        if kt is None:
-            continue
-        g = np.asarray(e.gather[0], dtype=float)
-        ks = float(g @ (K @ g)) / float(g @ g)
-        if ks > 0 and kt >= STIFF_CONTACT * ks:
-            out.append((i, kt / ks))
-    return out
 
 
 def stiff_sampled_contacts(case) -> list:

@@ -22,8 +22,8 @@ import numpy as np
 
 from elements.kernels import law_init, law_step
 
-from hbm.analyses.aft_retry import stiff_contacts
 from hbm.balance.fourier import FourierBasis, basis_matrix
+from hbm.model.contact_stiffness import stiff_contacts
 from hbm.timedomain.condensed_twin import time_model
 from hbm.timedomain.shooting import floquet_verdict, set_state, shoot
 from hbm.timedomain.time_parts import pack_elements
@@ -157,7 +157,7 @@ MAX_CONFIRM = 40            # Hill-unstable points checked per FRF at least, if 
 CONFIRM_SECONDS = 30.0      # and more while the checks have taken less than this
 MAX_STATE = 400             # 3 n + n_S above which the check is not run (cost ~ m n^2 per step)
 CONFIRM_STEPS = 256         # the FRF's own checks: the verdicts of 1024 steps at a quarter of the cost
-FINE_STEPS = 1024           # ... on models with stiff contacts (hbm.analyses.aft_retry.stiff_contacts)
+FINE_STEPS = 1024           # ... on models with stiff contacts (hbm.model.contact_stiffness.stiff_contacts)
 LONG_RUN = 8                # runs of more unstable points are sampled, not judged by their middle
 RUN_SAMPLES = 9             # checks spread over a long run (then its verdict changes bisected)
 
@@ -196,7 +196,7 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     whose contacts are 112-338 times stiffer than the structure along them: there 256 steps
     gave the opposite verdict at 20 of 24 points of 36.38-36.81 Hz, where 1024 and 4096 steps
     agree (and the same verdict at a point of 28-30 Hz, so one trial check does not tell).  A
-    model with stiff contacts (:func:`hbm.analyses.aft_retry.stiff_contacts`, at least 100
+    model with stiff contacts (:func:`hbm.model.contact_stiffness.stiff_contacts`, at least 100
     times) is checked at ``FINE_STEPS`` (``settings["floquet_steps"]``).
 
     Parameters
