@@ -85,3 +85,30 @@ def test_harmonics_beyond_need_are_noted():
     assert "H = 40 is more than this response needs; about H = 5 would keep them near 0.001" in note
     res = hbm.frf(case, harmonics=5, stability=False)
     assert 3e-4 < res.settings["error_estimate"]["max"]["x"]["error"] < 3e-3
+
+
+def test_points_with_every_contact_stuck_skip_the_richer_solve_and_agree_with_it():
+    """Where every contact sticks all period the richer basis adds nothing: the estimate is 0
+    without a richer solve, and the richer solve gives round-off there; where a contact slips
+    the shortcut is refused (its forces on 4N samples carry harmonics above H), also at a
+    point stuck on the N samples that slips between them."""
+    from hbm.analyses.problem_setup import build_problem
+    from hbm.analyses.stuck import stuck_contacts
+    from hbm.analyses.truncation import adds_nothing, embed, truncation_errors
+    case = CASES["inclined_contact"]()
+    res = hbm.frf(case, stability=False)
+    ws = 2 * np.pi * res.freq_hz
+    p, _ = build_problem(case, res.basis, "auto", float(res.freq_hz.max()))
+    rp, _ = build_problem(case, richer_basis(res.basis), "auto", float(res.freq_hz.max()))
+    stuck = stuck_contacts(p, res.X, ws) == len(case.elements)
+    assert 10 <= stuck.sum() < stuck.size - 10
+    full = truncation_errors(p, rp, res.X, ws)
+    short = truncation_errors(p, rp, res.X, ws, stuck)
+    zero = np.all(short == 0.0, axis=1)
+    assert res.settings["error_estimate"]["nothing_added"] == zero.sum() >= 0.9 * stuck.sum()
+    assert np.all(stuck[zero]) and np.all(full[zero] < 1e-12)
+    assert np.array_equal(short[~zero], full[~zero])
+    slipping = np.flatnonzero(~stuck & (full[:, 0] > 1e-8))
+    assert slipping.size
+    k = int(slipping[0])
+    assert not adds_nothing(p, rp, res.X[k], embed(res.X[k], p.basis, rp.basis), float(ws[k]))

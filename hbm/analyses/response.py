@@ -141,11 +141,12 @@ def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, option
         jumps = _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, stability_options)
         settings["stability_seconds"] += time.perf_counter() - t1        # + Floquet checks, jumps
     eouts = element_output_series(problem, case.analysis.element_outputs, Xs, np.array(pts_w))
-    if error_estimate and Xs.shape[0]:
-        outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings, t0)
     stuck = stuck_contacts(problem, Xs, np.array(pts_w))
     if stuck is not None:
         settings["stuck_points"] = int(np.count_nonzero(stuck))
+    if error_estimate and Xs.shape[0]:
+        linear = None if stuck is None else stuck == len(problem.nl.elements)
+        outputs = _with_errors(case, problem, outputs, Xs, np.array(pts_w), hi, settings, t0, linear)
     return FRFResult(freq_hz, outputs, Xs, basis, stable, folds,
                      np.array(eerr), np.array(its, dtype=int), status, message, n_rej, secs, settings,
                      jumps, eouts, Ys, stuck)
@@ -228,9 +229,11 @@ def _jumps(problem, case, Xs, freq_hz, outputs, stable, folds, xscale, r_scale, 
     return jumps
 
 
-def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings, t_solve) -> dict:
-    """``outputs`` with the truncation error estimate of every point (:mod:`hbm.analyses.truncation`);
-    ``settings`` gains ``error_estimate`` (computed, richer H, largest error per output) and,
+def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings, t_solve, linear=None) -> dict:
+    """``outputs`` with the truncation error estimate of every point (:mod:`hbm.analyses.truncation`;
+    ``linear`` (n_points,) marks the points with every contact stuck, where it may be 0 without a
+    richer solve); ``settings`` gains ``error_estimate`` (computed, richer H, largest error per
+    output, points estimated 0 without a solve) and,
     above ``WARN_ERROR``, a ``truncation_warning``, or far below it a ``harmonics_note`` (the FRF
     started at ``t_solve``, ``time.perf_counter``)."""
     t0 = time.perf_counter()
@@ -242,8 +245,10 @@ def _with_errors(case, problem, outputs, Xs, ws, fmax_hz, settings, t_solve) -> 
         settings["error_estimate"] = info
         return outputs
     rp, _ = build_problem(case, rb, "auto", fmax_hz)
-    E = truncation_errors(problem, rp, Xs, ws)
+    E = truncation_errors(problem, rp, Xs, ws, linear)
     info.update(computed=True, seconds=round(time.perf_counter() - t0, 6))
+    if linear is not None:
+        info["nothing_added"] = int(np.count_nonzero(linear & np.all(E == 0.0, axis=1)))
     out = {name: OutputSeries(o.h1, o.max, E[:, i]) for i, (name, o) in enumerate(outputs.items())}
     worst = info["max"] = largest_errors(out, ws / (2 * np.pi))
     settings["error_estimate"] = info

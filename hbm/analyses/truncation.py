@@ -17,7 +17,15 @@ relative error of each output's first harmonic is
 
     e = \frac{\big|\, |y_1(X + \delta)| - |y_1(X)| \,\big|}{|y_1(X + \delta)|}.
 
-It costs one residual, Jacobian and linear solve of the richer problem per point (solved
+Where the richer basis adds nothing, :math:`R'(X)` is the embedded balance residual itself
+and :math:`\delta` only Newton's last correction: when the element forces on :math:`N'`
+samples equal those on :math:`N` embedded (to ``SAME_FORCES`` of their size) and the load has
+no harmonic above :math:`H`, e.g. every contact stuck for the whole period (a linear law) or
+no element loaded, the estimate is 0 and the point costs two force evaluations (no seeds),
+not the richer Jacobian and solve.  The FRF tries this where every contact sticks for the
+whole period (:mod:`hbm.analyses.stuck`).
+
+Otherwise it costs one residual, Jacobian and linear solve of the richer problem per point (solved
 like the continuation's: :func:`continuation.linsolve.make_solver` on its harmonic blocks, so a
 contact patch costs block LUs and a few Krylov steps, not a dense LU), and the FRF computes it
 when that problem has at most ``MAX_UNKNOWNS`` unknowns (its settings say so otherwise): the
@@ -34,6 +42,7 @@ MAX_UNKNOWNS = 6000       # a richer Jacobian of 290 MB
 WARN_ERROR = 1e-2        # a point estimated worse than this is named in a warning
 NOTE_SHARE = 1e-2        # every point better than this share of WARN_ERROR: H far beyond need
 DECAY = 2.0              # friction's first-harmonic truncation error falls about as H^-DECAY
+SAME_FORCES = 1e-12      # richer forces within this share of their size of the embedded ones: nothing added
 
 
 def harmonics_note(H: int, top: float, n_unknowns: int, seconds: float) -> str | None:
@@ -107,7 +116,7 @@ def _h1(basis: FourierBasis, Y: np.ndarray) -> np.ndarray:
     return np.hypot(Y[r], Y[r + 1])
 
 
-def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
+def truncation_errors(problem, richer_problem, Xs, ws, linear=None) -> np.ndarray:
     """Estimated relative error of every output's first harmonic at every point.
 
     Parameters
@@ -117,17 +126,29 @@ def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
     Xs : ndarray, shape (n_points, n_coef, n)
     ws : ndarray, shape (n_points,)
         rad/s.
+    linear : ndarray of bool, shape (n_points,), optional
+        Points where the richer basis may add nothing (e.g. every contact stuck): there
+        :func:`adds_nothing` is tried first (it costs as much as the estimate at a point where
+        it fails, so it is not tried elsewhere).
 
     Returns
     -------
     ndarray, shape (n_points, n_outputs)
-        NaN where the richer Jacobian is singular.
+        NaN where the richer Jacobian is singular; 0 where the richer basis adds nothing
+        (:func:`adds_nothing`).
     """
     rp = richer_problem
     out = np.full((len(ws), rp.linear.output_rows.shape[0]), np.nan)
     solve = make_solver(rp.n_unknowns, rp.solver_structure())
+    new_rows = ~np.isin(rp.basis.h_of_row, problem.basis.h_of_row)
+    try_first = np.zeros(len(ws), dtype=bool) if linear is None else np.asarray(linear, dtype=bool)
+    if try_first.any() and np.any(rp.load(float(ws[0]))[new_rows] != 0.0):
+        try_first[:] = False                    # a load above H: the richer basis adds it
     for k, (X, w) in enumerate(zip(Xs, ws)):
         Xr = embed(X, problem.basis, rp.basis)
+        if try_first[k] and adds_nothing(problem, rp, X, Xr, float(w)):
+            out[k] = 0.0
+            continue
         R, J = rp.residual(Xr, float(w))[:2]
         d = solve(J, -R[:, None])
         if d is None or not np.all(np.isfinite(d)):
@@ -137,3 +158,12 @@ def truncation_errors(problem, richer_problem, Xs, ws) -> np.ndarray:
         y1 = _h1(rp.basis, rp.recover_outputs(rp.expand(rp.unknowns(Xr) + d), float(w)))
         out[k] = np.abs(y1 - y0) / np.maximum(y1, 1e-300)
     return out
+
+
+def adds_nothing(problem, richer_problem, X: np.ndarray, Xr: np.ndarray, w: float) -> bool:
+    """True when the element forces of ``Xr`` (``X`` (n_coef, n) embedded) on the richer basis
+    equal those of ``X`` embedded, to ``SAME_FORCES`` of the larger force coefficient: no
+    harmonic above ``H``, no aliasing of ``N`` samples (module doc).  Two force evaluations."""
+    Fr = richer_problem.nonlinear_forces(Xr, w)
+    F = embed(problem.nonlinear_forces(X, w), problem.basis, richer_problem.basis)
+    return float(np.abs(Fr - F).max(initial=0.0)) <= SAME_FORCES * float(np.abs(Fr).max(initial=0.0))
