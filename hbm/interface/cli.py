@@ -191,11 +191,11 @@ def cmd_frf(args) -> int:
     return 0
 
 
-def cmd_timesim(args) -> int:
+def _timesim_options(args):
+    """The ``TimeSimOptions`` of ``hbm timesim``'s arguments; CaseError naming a bad one."""
     import dataclasses
     import math
-    from hbm.timedomain.timesim import TimeSimOptions, timesim
-    from hbm.timedomain.timesim_report import write_timesim
+    from hbm.timedomain.timesim import TimeSimOptions
     f = args.freq_hz
     if not (math.isfinite(f) and f > 0):
         raise CaseError(f"--freq-hz must be a positive frequency in Hz, got {f:g}")
@@ -212,7 +212,15 @@ def cmd_timesim(args) -> int:
         over["floquet"] = True
     opts = dataclasses.replace(TimeSimOptions(), **over)
     opts.validate()
+    return opts
+
+
+def cmd_timesim(args) -> int:
+    from hbm.timedomain.timesim import timesim
+    from hbm.timedomain.timesim_report import write_timesim
     from hbm.interface.progress import CountProgress, compile_notice
+    f = args.freq_hz
+    opts = _timesim_options(args)
     case = load_case(args.case)
     if args.condensed:
         from hbm.analyses.problem_setup import condensed_time_model

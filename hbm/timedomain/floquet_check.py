@@ -12,6 +12,26 @@ two periods of ``z(t) = G E X`` sampled on the integrator's grid, so a friction 
 its hysteresis).  Shooting (:func:`hbm.timedomain.shooting.shoot`) then finds the periodic solution of the
 discrete time map next to it (Newton converges to unstable solutions as well), and its
 monodromy matrix gives the Floquet multipliers: the time-domain check of Hill's verdict.
+
+**Why Hill's unstable verdicts are checked** (:func:`confirm_unstable`).  For stick-slip,
+contact and stuck-friction laws the linearised harmonic operator can flag a point whose time
+solution is stable (the blade couple at 115.96 Hz: an isolated flag that comes and goes with
+H, while the period map's largest multiplier is 0.987).  Short runs of flags are checked
+first (an isolated flag is the most suspect); on the railcar rig a check takes 0.1 s, and 40
+checks spent on the short runs of 28-30 Hz left 429 points of 32-40 Hz unchecked, hence the
+time allowance beyond ``MAX_CONFIRM``.  Long runs are sampled: Hill calls 35.8-37 Hz on the
+railcar rig unstable, and Floquet agrees at the middle of that stretch but finds a stable
+window at 36.45-36.72 Hz (multipliers 0.69-0.94 at 1024 and 4096 steps alike).
+
+**Steps per period.**  At 25 points of ``upd_like``, 24 of the UPD flanks rig's (unstable
+ones included) and the blade couple's overridden point the verdicts of 256 steps are those of
+1024 wherever both converged, the largest multipliers 1e-5 apart on stable points and up to
+2 % on unstable ones.  Not so on the railcar rig, whose contacts are 112-338 times stiffer
+than the structure along them: there 256 steps gave the opposite verdict at 20 of 24 points
+of 36.38-36.81 Hz, where 1024 and 4096 steps agree (and the same verdict at a point of
+28-30 Hz, so one trial check does not tell).  Models with stiff contacts
+(:func:`hbm.model.contact_stiffness.stiff_contacts`, at least 100 times) are checked at
+``FINE_STEPS``.
 """
 from __future__ import annotations
 
@@ -169,35 +189,21 @@ def _non_smooth(packed) -> bool:
 
 def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndarray,
                      stable: np.ndarray, settings: dict, problem=None) -> np.ndarray:
-    """Hill's unstable verdicts checked by Floquet multipliers where Hill is not exact.
+    """Hill's unstable verdicts checked by Floquet multipliers where Hill is not exact (module
+    doc): on a small model (``3 n + n_S <= MAX_STATE``) with a non-smooth law and no velocity
+    law.
 
-    Hill's method linearises the balance; for stick-slip, contact and stuck-friction laws the
-    linearised harmonic operator can flag a point whose time solution is stable (seen on
-    the blade couple at 115.96 Hz: an isolated flag that comes and goes with H, while the
-    period map's largest multiplier is 0.987).  When the model has a non-smooth law, is small
-    (``3 n + n_S <= MAX_STATE``) and has no velocity law, the runs of
-    consecutive points Hill calls unstable are checked with :func:`check_point`, the shortest
-    runs first (an isolated flag is the most suspect), ``MAX_CONFIRM`` checks, and more while
-    they have taken less than ``CONFIRM_SECONDS`` (on the railcar rig a check takes 0.1 s; 40
-    were spent on the short runs of 28-30 Hz and left 429 points of 32-40 Hz unchecked).
-    A run of at most ``LONG_RUN`` points is judged by its middle point first: if Floquet
-    confirms it (or shooting does not converge), Hill's verdict stands for the run; if Floquet
-    calls it stable, every point of the run is checked and a converged Floquet verdict
-    replaces Hill's.  A longer run is checked at ``RUN_SAMPLES`` points spread over it
-    (:func:`_sampled_run`): on the railcar rig Hill calls 35.8-37 Hz unstable, and Floquet
-    agrees at the middle of that stretch but finds a stable window at 36.45-36.72 Hz
-    (multipliers 0.69-0.94 at 1024 and 4096 steps alike).  ``settings["floquet_checked"]``
-    counts the checks, ``settings["floquet_overrides_hz"]`` lists the points turned stable and
-    ``settings["floquet_unchecked"]`` counts the unstable points left unchecked by the cap.
-    The checks take ``CONFIRM_STEPS`` steps per period: at 25 points of ``upd_like``, 24 of
-    the UPD flanks rig's (unstable ones included) and the blade couple's overridden point the
-    verdicts of 256 steps are those of 1024 wherever both converged, the largest multipliers
-    1e-5 apart on stable points and up to 2 % on unstable ones.  Not so on the railcar rig,
-    whose contacts are 112-338 times stiffer than the structure along them: there 256 steps
-    gave the opposite verdict at 20 of 24 points of 36.38-36.81 Hz, where 1024 and 4096 steps
-    agree (and the same verdict at a point of 28-30 Hz, so one trial check does not tell).  A
-    model with stiff contacts (:func:`hbm.model.contact_stiffness.stiff_contacts`, at least 100
-    times) is checked at ``FINE_STEPS`` (``settings["floquet_steps"]``).
+    The runs of consecutive points Hill calls unstable are checked with :func:`check_point`,
+    the shortest runs first, ``MAX_CONFIRM`` checks and more while they have taken less than
+    ``CONFIRM_SECONDS``.  A run of at most ``LONG_RUN`` points is judged by its middle point
+    first: if Floquet confirms it (or shooting does not converge), Hill's verdict stands for
+    the run; if Floquet calls it stable, every point of the run is checked and a converged
+    Floquet verdict replaces Hill's.  A longer run is checked at ``RUN_SAMPLES`` points
+    spread over it (:func:`_sampled_run`).  The checks take ``CONFIRM_STEPS`` steps per
+    period, ``FINE_STEPS`` on a model with stiff contacts (``settings["floquet_steps"]``).
+    ``settings["floquet_checked"]`` counts the checks, ``settings["floquet_overrides_hz"]``
+    lists the points turned stable and ``settings["floquet_unchecked"]`` counts the unstable
+    points left unchecked by the cap.
 
     Parameters
     ----------
@@ -218,42 +224,26 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     if (not _non_smooth(packed) or np.any(packed.laws[6]) or 3 * model.n_dof + packed.n_states > MAX_STATE
             or (model is case and Xs.shape[-1] != case.n_dof)):
         return stable
-    out = stable.copy()
-    turned, checks, unchecked = [], 0, 0
-    t0 = time.perf_counter()
     steps = settings["floquet_steps"] = FINE_STEPS if stiff_contacts(case) else CONFIRM_STEPS
-
-    def spent() -> bool:
-        return checks >= MAX_CONFIRM and time.perf_counter() - t0 >= CONFIRM_SECONDS
+    budget = _Budget()
 
     def stable_at(i):
         """Floquet's verdict at point ``i`` (True: converged and stable), or None past the cap."""
-        nonlocal checks
-        if spent():
+        if not budget.take():
             return None
-        checks += 1
-
         c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
         return bool(c.converged and c.stable)
 
-    runs = np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)
-    for run in sorted(runs, key=len):
-        if spent():
+    out, turned, unchecked = stable.copy(), [], 0
+    for run in sorted(np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1), key=len):
+        if budget.spent():
             unchecked += run.size
             continue
-        if run.size > LONG_RUN:
-            now = _sampled_run(run, stable_at)
-        else:
-            mid = int(run[run.size // 2])
-            now = {mid} if stable_at(mid) else set()
-            if now:
-                rest = [(int(i), stable_at(int(i))) for i in run if i != mid]
-                now |= {i for i, v in rest if v}
-                unchecked += sum(v is None for _, v in rest)
-        for i in sorted(now):
-            out[i] = True
-            turned.append(round(float(freq_hz[i]), 6))
-    settings["floquet_checked"] = checks
+        now, left = _sampled_run(run, stable_at) if run.size > LONG_RUN else _short_run(run, stable_at)
+        unchecked += left
+        out[sorted(now)] = True
+        turned += [round(float(freq_hz[i]), 6) for i in sorted(now)]
+    settings["floquet_checked"] = budget.checks
     if unchecked:
         settings["floquet_unchecked"] = unchecked
     if turned:
@@ -261,8 +251,35 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     return out
 
 
-def _sampled_run(run: np.ndarray, stable_at) -> set:
-    """Points of a long unstable run (indices (L,)) that Floquet turns stable.
+class _Budget:
+    """Checks counted against ``MAX_CONFIRM`` and ``CONFIRM_SECONDS`` (spent when both are)."""
+
+    def __init__(self):
+        self.checks, self._t0 = 0, time.perf_counter()
+
+    def spent(self) -> bool:
+        return self.checks >= MAX_CONFIRM and time.perf_counter() - self._t0 >= CONFIRM_SECONDS
+
+    def take(self) -> bool:
+        """False past the cap; else one more check counted."""
+        if self.spent():
+            return False
+        self.checks += 1
+        return True
+
+
+def _short_run(run: np.ndarray, stable_at):
+    """``(points turned stable, points left unchecked)`` of a run of at most ``LONG_RUN``
+    unstable points (indices (L,)): its middle first, the others only if Floquet turns it."""
+    mid = int(run[run.size // 2])
+    if not stable_at(mid):
+        return set(), 0
+    rest = [(int(i), stable_at(int(i))) for i in run if i != mid]
+    return {mid} | {i for i, v in rest if v}, sum(v is None for _, v in rest)
+
+
+def _sampled_run(run: np.ndarray, stable_at) -> tuple:
+    """``(points turned stable, 0)`` of a long unstable run (indices (L,)).
 
     ``RUN_SAMPLES`` points spread evenly over the run are checked; between two neighbouring
     samples of the same verdict every point takes it (an assumption, as for Hill's verdicts
@@ -286,4 +303,4 @@ def _sampled_run(run: np.ndarray, stable_at) -> set:
             v[m] = bool(stable_at(int(run[m])))
             lo, hi = (m, hi) if v[m] == v[a] else (lo, m)
         now |= set(range(a + 1, lo + 1)) if v[a] else set(range(hi, b))
-    return {int(run[p]) for p in now}
+    return {int(run[p]) for p in now}, 0
