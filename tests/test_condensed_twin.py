@@ -260,6 +260,40 @@ def test_runs_of_unstable_points_are_confirmed_by_their_middle(monkeypatch):
     assert asked == [9.0, 13.0, 12.0] and st["floquet_unchecked"] == 1 + 5     # 14, and the run 2-6
 
 
+def test_stable_islands_between_unstable_points_are_checked_too(monkeypatch):
+    """Short runs Hill calls stable between unstable points (the railcar's 36.00-36.06 Hz,
+    largest multipliers 1.5) are checked by their middle after the unstable runs; an island
+    Floquet calls unstable is checked point by point, one it calls stable stays, and runs at
+    the path's ends or longer than LONG_RUN are not islands."""
+    from hbm.timedomain import floquet_check as fc
+    case = duffing_chain("full")
+    n = 40
+    freq = np.arange(float(n))
+    stable = np.zeros(n, dtype=bool)
+    stable[[0, 5, 6, 7, 12, 13]] = True                         # end run 0, islands 5-7 and 12-13
+    stable[20:20 + fc.LONG_RUN + 1] = True                      # too long for an island
+    truly_unstable = set(range(n)) - {6, 7, 12, 13}             # Floquet: 5 unstable, 6-7 not
+    asked = []
+
+    def fake(case, basis, X, f, steps, problem):
+        asked.append(int(f))
+        return fc.FloquetCheck(int(f) not in truly_unstable, 1.0, True, 0.0, "", {}, {}, 1)
+    monkeypatch.setattr(fc, "check_point", fake)
+    monkeypatch.setattr(fc, "MAX_CONFIRM", 10 ** 6)
+    st = {}
+    out = fc.confirm_unstable(case, None, np.zeros((n, 3, case.n_dof)), freq, stable, st)
+    unstable_runs = [i for i in asked if not stable[i]]
+    assert asked[len(unstable_runs):] == [13, 6]                # islands, shortest first, by the middle
+    assert st["floquet_checked"] == len(asked) and "floquet_unstable_hz" not in st
+    assert np.array_equal(out, stable)
+    truly_unstable.add(6)                                       # now the middle of 5-7 is unstable
+    asked.clear()
+    st = {}
+    out = fc.confirm_unstable(case, None, np.zeros((n, 3, case.n_dof)), freq, stable, st)
+    assert asked[-4:] == [13, 6, 5, 7] and st["floquet_unstable_hz"] == [5.0, 6.0]
+    assert list(np.flatnonzero(out)) == [0, 7, 12, 13] + list(range(20, 20 + fc.LONG_RUN + 1))
+
+
 def test_a_long_run_is_sampled_and_its_stable_window_bisected(monkeypatch):
     """A run longer than LONG_RUN (the railcar's Hill-unstable 35.8-37 Hz holds a window that
     Floquet calls stable) is checked at RUN_SAMPLES points; each change of verdict between two

@@ -107,7 +107,11 @@ def _confirmed(case, res, base_harmonics: int):
     if turned:
         res.settings["floquet_overrides_hz"] = sorted(res.settings.get("floquet_overrides_hz", []) + turned)
     res.settings["floquet_checked"] = res.settings.get("floquet_checked", 0) + st.get("floquet_checked", 0)
-    return dataclasses.replace(res, stable=np.where(refined, checked, res.stable))
+    stable = np.where(refined, checked, res.stable)
+    lost = [round(float(f), 6) for f in res.freq_hz[res.stable & ~stable]]       # islands turned
+    if lost:
+        res.settings["floquet_unstable_hz"] = sorted(res.settings.get("floquet_unstable_hz", []) + lost)
+    return dataclasses.replace(res, stable=stable)
 
 
 def _restate_errors(res) -> None:

@@ -64,6 +64,11 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
         fl = st["floquet_overrides_hz"]
         print(f"  note: {len(fl)} point(s) Hill called unstable are stable by the Floquet multipliers of the "
               f"time-domain period map (at {', '.join(f'{f:.6g}' for f in fl[:5])} Hz); the verdicts are Floquet's")
+    if st.get("floquet_unstable_hz"):
+        fl = st["floquet_unstable_hz"]
+        print(f"  note: {len(fl)} point(s) Hill called stable between unstable ones are unstable by the Floquet "
+              f"multipliers of the time-domain period map (at {', '.join(f'{f:.6g}' for f in fl[:5])} Hz); "
+              f"the verdicts are Floquet's")
     if st.get("floquet_unchecked"):
         print(f"  note: {st['floquet_unchecked']} point(s) Hill calls unstable were not checked by Floquet "
               f"multipliers (the checks stop past 40 and 30 s per FRF): their verdicts are Hill's")

@@ -21,7 +21,11 @@ first (an isolated flag is the most suspect); on the railcar rig a check takes 0
 checks spent on the short runs of 28-30 Hz left 429 points of 32-40 Hz unchecked, hence the
 time allowance beyond ``MAX_CONFIRM``.  Long runs are sampled: Hill calls 35.8-37 Hz on the
 railcar rig unstable, and Floquet agrees at the middle of that stretch but finds a stable
-window at 36.45-36.72 Hz (multipliers 0.69-0.94 at 1024 and 4096 steps alike).
+window at 36.45-36.72 Hz (multipliers 0.69-0.94 at 1024 and 4096 steps alike).  Hill errs
+the other way too: in the same stretch it calls 36.00, 36.02-36.03 and 36.06 Hz stable, islands
+in an unstable run, where the period map's largest multipliers are 1.50-1.58 (1024 and 4096
+steps, the time solution within 0.7 % of the balance point), so short stable islands are
+checked as well.
 
 **Steps per period.**  At 25 points of ``upd_like``, 24 of the UPD flanks rig's (unstable
 ones included) and the blade couple's overridden point the verdicts of 256 steps are those of
@@ -199,7 +203,10 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     first: if Floquet confirms it (or shooting does not converge), Hill's verdict stands for
     the run; if Floquet calls it stable, every point of the run is checked and a converged
     Floquet verdict replaces Hill's.  A longer run is checked at ``RUN_SAMPLES`` points
-    spread over it (:func:`_sampled_run`).  The checks take ``CONFIRM_STEPS`` steps per
+    spread over it (:func:`_sampled_run`).  Then, while the cap allows, each *island* of at
+    most ``LONG_RUN`` points Hill calls stable between two unstable points is checked by its
+    middle point the same way, a converged unstable Floquet verdict replacing Hill's
+    (``settings["floquet_unstable_hz"]``).  The checks take ``CONFIRM_STEPS`` steps per
     period, ``FINE_STEPS`` on a model with stiff contacts (``settings["floquet_steps"]``).
     ``settings["floquet_checked"]`` counts the checks, ``settings["floquet_overrides_hz"]``
     lists the points turned stable and ``settings["floquet_unchecked"]`` counts the unstable
@@ -234,6 +241,13 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
         c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
         return bool(c.converged and c.stable)
 
+    def unstable_at(i):
+        """True where Floquet calls point ``i`` unstable (converged), None past the cap."""
+        if not budget.take():
+            return None
+        c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
+        return bool(c.converged and not c.stable)
+
     out, turned, unchecked = stable.copy(), [], 0
     for run in sorted(np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1), key=len):
         if budget.spent():
@@ -243,12 +257,28 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
         unchecked += left
         out[sorted(now)] = True
         turned += [round(float(freq_hz[i]), 6) for i in sorted(now)]
+    lost = set()
+    for run in sorted(_islands(out, stable), key=len):
+        if budget.spent():
+            break
+        lost |= _short_run(run, unstable_at)[0]
+    out[sorted(lost)] = False
     settings["floquet_checked"] = budget.checks
     if unchecked:
         settings["floquet_unchecked"] = unchecked
     if turned:
         settings["floquet_overrides_hz"] = sorted(turned)
+    if lost:
+        settings["floquet_unstable_hz"] = sorted(round(float(freq_hz[i]), 6) for i in lost)
     return out
+
+
+def _islands(out: np.ndarray, hill: np.ndarray) -> list:
+    """Runs (indices) of at most ``LONG_RUN`` points that Hill calls stable (``hill``, (n,))
+    with an unstable point on either side by the verdicts ``out`` (n,) (module doc)."""
+    good = np.flatnonzero(out)
+    runs = np.split(good, np.flatnonzero(np.diff(good) > 1) + 1) if good.size else []
+    return [r for r in runs if r.size <= LONG_RUN and r[0] > 0 and r[-1] < out.size - 1 and hill[r].all()]
 
 
 class _Budget:
@@ -268,13 +298,14 @@ class _Budget:
         return True
 
 
-def _short_run(run: np.ndarray, stable_at):
-    """``(points turned stable, points left unchecked)`` of a run of at most ``LONG_RUN``
-    unstable points (indices (L,)): its middle first, the others only if Floquet turns it."""
+def _short_run(run: np.ndarray, turns):
+    """``(points turned, points left unchecked)`` of a run of at most ``LONG_RUN`` points
+    (indices (L,)) by ``turns(i)`` (True: Floquet reverses Hill's verdict, None: past the
+    cap): its middle first, the others only if Floquet turns it."""
     mid = int(run[run.size // 2])
-    if not stable_at(mid):
+    if not turns(mid):
         return set(), 0
-    rest = [(int(i), stable_at(int(i))) for i in run if i != mid]
+    rest = [(int(i), turns(int(i))) for i in run if i != mid]
     return {mid} | {i for i, v in rest if v}, sum(v is None for _, v in rest)
 
 
