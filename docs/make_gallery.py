@@ -31,6 +31,8 @@ def _worst_estimate(settings) -> str:
     if not est:
         return ""
     name, v = max(est.items(), key=lambda kv: kv[1]["error"])
+    if v["error"] == 0.0:
+        return ", estimated truncation error 0 at every point (the richer harmonics add nothing)"
     return f", estimated error of {name}_h1 up to {v['error']:.1e} (at {v['freq_hz']:.5g} Hz)"
 
 

@@ -232,14 +232,15 @@ residual_flexibility = true
 
 
 def test_runs_of_unstable_points_are_confirmed_by_their_middle(monkeypatch):
-    """Runs are checked shortest first, each by its middle point; a run whose middle Floquet
-    calls stable is checked point by point; the cap leaves the rest to Hill, counted."""
+    """Runs are checked shortest first, each by its middle point (the stable islands 7-8 and
+    10-11 between them too); a run whose middle Floquet calls stable is checked point by
+    point; the cap leaves the rest to Hill, counted."""
     from hbm.timedomain import floquet_check as fc
     case = duffing_chain("full")
     freq = np.arange(20.0)
     stable = np.ones(20, dtype=bool)
     stable[[2, 3, 4, 5, 6, 9, 12, 13, 14]] = False             # runs 2-6, 9, 12-14
-    truly_stable = {9.0, 12.0, 13.0}                            # Floquet's verdicts
+    truly_stable = {7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 13.0}      # Floquet's verdicts
     asked = []
 
     def fake(case, basis, X, f, steps, problem):
@@ -249,22 +250,22 @@ def test_runs_of_unstable_points_are_confirmed_by_their_middle(monkeypatch):
     Xs = np.zeros((20, 3, case.n_dof))
     st = {}
     out = fc.confirm_unstable(case, None, Xs, freq, stable, st)
-    assert asked == [9.0, 13.0, 12.0, 14.0, 4.0]                # shortest first; 12-14 turned, so all of it
+    assert asked == [9.0, 8.0, 11.0, 13.0, 12.0, 14.0, 4.0]    # shortest first; 12-14 turned, so all of it
     assert list(np.flatnonzero(~out)) == [2, 3, 4, 5, 6, 14]
-    assert st == {"floquet_checked": 5, "floquet_steps": 256, "floquet_overrides_hz": [9.0, 12.0, 13.0]}
+    assert st == {"floquet_checked": 7, "floquet_steps": 256, "floquet_overrides_hz": [9.0, 12.0, 13.0]}
     monkeypatch.setattr(fc, "MAX_CONFIRM", 3)
     monkeypatch.setattr(fc, "CONFIRM_SECONDS", 0.0)
     asked.clear()
     st = {}
     out = fc.confirm_unstable(case, None, Xs, freq, stable, st)
-    assert asked == [9.0, 13.0, 12.0] and st["floquet_unchecked"] == 1 + 5     # 14, and the run 2-6
+    assert asked == [9.0, 8.0, 11.0] and st["floquet_unchecked"] == 3 + 5     # the runs 12-14 and 2-6
 
 
 def test_stable_islands_between_unstable_points_are_checked_too(monkeypatch):
     """Short runs Hill calls stable between unstable points (the railcar's 36.00-36.06 Hz,
-    largest multipliers 1.5) are checked by their middle after the unstable runs; an island
-    Floquet calls unstable is checked point by point, one it calls stable stays, and runs at
-    the path's ends or longer than LONG_RUN are not islands."""
+    largest multipliers 1.5) are checked by their middle in one queue with the unstable runs,
+    shortest first; an island Floquet calls unstable is checked point by point, one it calls
+    stable stays, and runs at the path's ends or longer than LONG_RUN are not islands."""
     from hbm.timedomain import floquet_check as fc
     case = duffing_chain("full")
     n = 40
@@ -282,15 +283,15 @@ def test_stable_islands_between_unstable_points_are_checked_too(monkeypatch):
     monkeypatch.setattr(fc, "MAX_CONFIRM", 10 ** 6)
     st = {}
     out = fc.confirm_unstable(case, None, np.zeros((n, 3, case.n_dof)), freq, stable, st)
-    unstable_runs = [i for i in asked if not stable[i]]
-    assert asked[len(unstable_runs):] == [13, 6]                # islands, shortest first, by the middle
+    assert asked[:2] == [13, 6]                                 # islands 12-13 and 5-7 by their middle
+    assert asked[2:5] == [3, 10, 17]                            # then the unstable runs 1-4, 8-11, 14-19
     assert st["floquet_checked"] == len(asked) and "floquet_unstable_hz" not in st
     assert np.array_equal(out, stable)
     truly_unstable.add(6)                                       # now the middle of 5-7 is unstable
     asked.clear()
     st = {}
     out = fc.confirm_unstable(case, None, np.zeros((n, 3, case.n_dof)), freq, stable, st)
-    assert asked[-4:] == [13, 6, 5, 7] and st["floquet_unstable_hz"] == [5.0, 6.0]
+    assert asked[:4] == [13, 6, 5, 7] and st["floquet_unstable_hz"] == [5.0, 6.0]
     assert list(np.flatnonzero(out)) == [0, 7, 12, 13] + list(range(20, 20 + fc.LONG_RUN + 1))
 
 
@@ -341,3 +342,25 @@ def test_a_model_with_stiff_contacts_is_checked_at_finer_steps(monkeypatch):
         st = {}
         fc.confirm_unstable(case, None, np.zeros((4, 3, case.n_dof)), np.arange(4.0), stable, st)
         assert asked == [steps] and st["floquet_steps"] == steps
+
+
+def test_the_checks_may_take_a_quarter_of_hills_time_when_that_is_longer(monkeypatch):
+    """The railcar's Hill spectra take 262 s: its Floquet checks may take a quarter of that,
+    not only CONFIRM_SECONDS (which left 325 unstable points unchecked there)."""
+    from hbm.timedomain import floquet_check as fc
+    case = duffing_chain("full")
+    seen = []
+    real = fc._Budget
+
+    def budget(seconds):
+        seen.append(seconds)
+        return real(seconds)
+    monkeypatch.setattr(fc, "_Budget", budget)
+    monkeypatch.setattr(fc, "check_point", lambda *a, **k: fc.FloquetCheck(False, 2.0, True, 0.0, "", {}, {}, 1))
+    stable = np.array([True, False, True])
+    for hill_seconds, allowed in ((10.0, fc.CONFIRM_SECONDS), (400.0, 100.0)):
+        fc.confirm_unstable(case, None, np.zeros((3, 3, case.n_dof)), np.arange(3.0), stable,
+                            {"stability_seconds": hill_seconds})
+        assert seen[-1] == allowed
+    b = real(0.0)
+    assert all(b.take() for _ in range(fc.MAX_CONFIRM)) and b.spent() and not b.take()

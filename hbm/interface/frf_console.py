@@ -71,12 +71,17 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
               f"the verdicts are Floquet's")
     if st.get("floquet_unchecked"):
         print(f"  note: {st['floquet_unchecked']} point(s) Hill calls unstable were not checked by Floquet "
-              f"multipliers (the checks stop past 40 and 30 s per FRF): their verdicts are Hill's")
+              f"multipliers (the checks stop past 40 and 30 s per FRF, or a quarter of Hill's time if longer): "
+              f"their verdicts are Hill's")
     if st.get("stuck_points"):
         print(f"  note: at {st['stuck_points']} points a contact sticks for the whole period: its slider offset, "
               f"hence the mean and max |y|, is one of a family of periodic solutions (column stuck_contacts)")
     for name, v in (st.get("error_estimate") or {}).get("max", {}).items():
-        print(f"  largest estimated error of {name}_h1 {v['error']:.1e} at {v['freq_hz']:.6g} Hz (harmonic truncation)")
+        if v["error"] == 0.0:
+            print(f"  estimated error of {name}_h1 0 at every point (the richer harmonics add nothing)")
+        else:
+            print(f"  largest estimated error of {name}_h1 {v['error']:.1e} at {v['freq_hz']:.6g} Hz "
+                  f"(harmonic truncation)")
 
 
 def _defaults_note(st) -> str:

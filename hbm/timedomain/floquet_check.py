@@ -25,7 +25,11 @@ window at 36.45-36.72 Hz (multipliers 0.69-0.94 at 1024 and 4096 steps alike).  
 the other way too: in the same stretch it calls 36.00, 36.02-36.03 and 36.06 Hz stable, islands
 in an unstable run, where the period map's largest multipliers are 1.50-1.58 (1024 and 4096
 steps, the time solution within 0.7 % of the balance point), so short stable islands are
-checked as well.
+checked as well, in one queue with the unstable runs (on the whole railcar FRF a 30 s cap
+was reached before every unstable run was checked: islands queued after them were never
+checked, and queued with them they left 325 unstable points unchecked, against 170 before).
+Hill's spectra take 262 s there (H = 25, 705 points), so the checks may take a quarter of
+that (``CONFIRM_SHARE``) when it is more than ``CONFIRM_SECONDS``.
 
 **Steps per period.**  At 25 points of ``upd_like``, 24 of the UPD flanks rig's (unstable
 ones included) and the blade couple's overridden point the verdicts of 256 steps are those of
@@ -178,7 +182,8 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
 
 
 MAX_CONFIRM = 40            # Hill-unstable points checked per FRF at least, if there are so many,
-CONFIRM_SECONDS = 30.0      # and more while the checks have taken less than this
+CONFIRM_SECONDS = 30.0      # and more while the checks have taken less than this,
+CONFIRM_SHARE = 0.25        # or than this share of the Hill spectra's seconds (settings["stability_seconds"])
 MAX_STATE = 400             # 3 n + n_S above which the check is not run (cost ~ m n^2 per step)
 CONFIRM_STEPS = 256         # the FRF's own checks: the verdicts of 1024 steps at a quarter of the cost
 FINE_STEPS = 1024           # ... on models with stiff contacts (hbm.model.contact_stiffness.stiff_contacts)
@@ -199,13 +204,14 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
 
     The runs of consecutive points Hill calls unstable are checked with :func:`check_point`,
     the shortest runs first, ``MAX_CONFIRM`` checks and more while they have taken less than
-    ``CONFIRM_SECONDS``.  A run of at most ``LONG_RUN`` points is judged by its middle point
+    ``CONFIRM_SECONDS`` or ``CONFIRM_SHARE`` of the time Hill's spectra took
+    (``settings["stability_seconds"]`` on entry).  A run of at most ``LONG_RUN`` points is judged by its middle point
     first: if Floquet confirms it (or shooting does not converge), Hill's verdict stands for
     the run; if Floquet calls it stable, every point of the run is checked and a converged
     Floquet verdict replaces Hill's.  A longer run is checked at ``RUN_SAMPLES`` points
-    spread over it (:func:`_sampled_run`).  Then, while the cap allows, each *island* of at
-    most ``LONG_RUN`` points Hill calls stable between two unstable points is checked by its
-    middle point the same way, a converged unstable Floquet verdict replacing Hill's
+    spread over it (:func:`_sampled_run`).  Each *island* of at most ``LONG_RUN`` points Hill
+    calls stable between two unstable points is checked as a short run, in the same order of
+    length, a converged unstable Floquet verdict replacing Hill's
     (``settings["floquet_unstable_hz"]``).  The checks take ``CONFIRM_STEPS`` steps per
     period, ``FINE_STEPS`` on a model with stiff contacts (``settings["floquet_steps"]``).
     ``settings["floquet_checked"]`` counts the checks, ``settings["floquet_overrides_hz"]``
@@ -232,7 +238,7 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
             or (model is case and Xs.shape[-1] != case.n_dof)):
         return stable
     steps = settings["floquet_steps"] = FINE_STEPS if stiff_contacts(case) else CONFIRM_STEPS
-    budget = _Budget()
+    budget = _Budget(max(CONFIRM_SECONDS, CONFIRM_SHARE * settings.get("stability_seconds", 0.0)))
 
     def stable_at(i):
         """Floquet's verdict at point ``i`` (True: converged and stable), or None past the cap."""
@@ -248,20 +254,18 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
         c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
         return bool(c.converged and not c.stable)
 
-    out, turned, unchecked = stable.copy(), [], 0
-    for run in sorted(np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1), key=len):
+    out, turned, lost, unchecked = stable.copy(), [], set(), 0
+    runs = [(r, False) for r in np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)]
+    for run, island in sorted(runs + [(r, True) for r in _islands(stable)], key=lambda ri: ri[0].size):
         if budget.spent():
-            unchecked += run.size
-            continue
-        now, left = _sampled_run(run, stable_at) if run.size > LONG_RUN else _short_run(run, stable_at)
-        unchecked += left
-        out[sorted(now)] = True
-        turned += [round(float(freq_hz[i]), 6) for i in sorted(now)]
-    lost = set()
-    for run in sorted(_islands(out, stable), key=len):
-        if budget.spent():
-            break
-        lost |= _short_run(run, unstable_at)[0]
+            unchecked += 0 if island else run.size
+        elif island:
+            lost |= _short_run(run, unstable_at)[0]
+        else:
+            now, left = _sampled_run(run, stable_at) if run.size > LONG_RUN else _short_run(run, stable_at)
+            unchecked += left
+            out[sorted(now)] = True
+            turned += [round(float(freq_hz[i]), 6) for i in sorted(now)]
     out[sorted(lost)] = False
     settings["floquet_checked"] = budget.checks
     if unchecked:
@@ -273,22 +277,22 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     return out
 
 
-def _islands(out: np.ndarray, hill: np.ndarray) -> list:
-    """Runs (indices) of at most ``LONG_RUN`` points that Hill calls stable (``hill``, (n,))
-    with an unstable point on either side by the verdicts ``out`` (n,) (module doc)."""
-    good = np.flatnonzero(out)
+def _islands(stable: np.ndarray) -> list:
+    """Runs (indices) of at most ``LONG_RUN`` points that Hill calls stable (``stable`` (n,))
+    with an unstable point on either side (module doc)."""
+    good = np.flatnonzero(stable)
     runs = np.split(good, np.flatnonzero(np.diff(good) > 1) + 1) if good.size else []
-    return [r for r in runs if r.size <= LONG_RUN and r[0] > 0 and r[-1] < out.size - 1 and hill[r].all()]
+    return [r for r in runs if r.size <= LONG_RUN and r[0] > 0 and r[-1] < stable.size - 1]
 
 
 class _Budget:
-    """Checks counted against ``MAX_CONFIRM`` and ``CONFIRM_SECONDS`` (spent when both are)."""
+    """Checks counted against ``MAX_CONFIRM`` and ``seconds`` (spent when both are)."""
 
-    def __init__(self):
-        self.checks, self._t0 = 0, time.perf_counter()
+    def __init__(self, seconds: float):
+        self.checks, self.seconds, self._t0 = 0, seconds, time.perf_counter()
 
     def spent(self) -> bool:
-        return self.checks >= MAX_CONFIRM and time.perf_counter() - self._t0 >= CONFIRM_SECONDS
+        return self.checks >= MAX_CONFIRM and time.perf_counter() - self._t0 >= self.seconds
 
     def take(self) -> bool:
         """False past the cap; else one more check counted."""
