@@ -141,7 +141,8 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
     if res.settings.get("time_fill"):
         _draw_fill(ax, res.settings["time_fill"]["points"], list(res.outputs), colours, scale)
     if res.stable is not None and not stable.all():
-        ax.plot([], [], "k:", lw=2.0, label="unstable (Hill)")
+        checked = res.settings.get("floquet_checked", 0) > 0
+        ax.plot([], [], "k:", lw=2.0, label="unstable (Hill; Floquet where checked)" if checked else "unstable (Hill)")
     if jumps and any(j.get(w) for j in jumps.values() for w in JUMP_COLOURS):
         for way, colour in JUMP_COLOURS.items():
             ax.plot([], [], color=colour, marker=r"$\uparrow$", ls="", label=f"jump, sweep {way}")
