@@ -1,18 +1,18 @@
 """A run that stops short with stiff sampled contacts is traced again on their exact AFT.
 
-A sampled AFT puts a contact's switches on the time grid: for a stiff contact (``kt`` at
-least ``STIFF_CONTACT`` times the structure's stiffness along its first coordinate,
+A sampled AFT puts a contact's switches on the time grid: for a stiff contact (``kt`` at least
+``STIFF_CONTACT`` times the structure's stiffness along its first coordinate,
 :mod:`hbm.model.contact_stiffness`) that is an error Newton cannot average out, and the path
 may stall there.  The elements that offer an event-based AFT (``events_available``: Jenkins,
-friction3d on (t1, n)) compute the same law exactly from its events.  So when an FRF with such contacts stops or
-leaves gaps, :func:`retry_with_events` traces the window again with ``aft = "events"`` on
-them and keeps the run that covers more of it: a finished run before a stopped one, then the
-untraced width (gaps, the window's ends a stopped run did not reach, a hole between a
-folded-back start and a trace from the top) if it is at most ``SHARE`` of the first run's;
-else the first run.  ``settings["aft_retry"]`` says what was tried, what each run left untraced and
-which was kept.  A first run longer than ``RETRY_SECONDS`` is not repeated (it would double a
-long run, e.g. the railcar rig's 150 s for 0.005 Hz more): its ``contact_hint`` says what to
-try.
+friction3d on (t1, n)) compute the same law exactly from its events.  So when an FRF with such
+contacts stops or leaves gaps, :func:`retry_with_events` traces the window again with
+``aft = "events"`` on them and keeps the run that covers more of it: a finished run before a
+stopped one, then the untraced width (gaps, the window's ends a stopped run did not reach, a
+hole between a folded-back start and a trace from the top) if it is at most ``SHARE`` of the
+first run's; else the first run.  ``settings["aft_retry"]`` says what was tried, what each run
+left untraced and which was kept.  A first run longer than ``RETRY_SECONDS`` is not repeated
+(it would double a long run, e.g. the railcar rig's 150 s for 0.005 Hz more): its
+``contact_hint`` says what to try.
 """
 from __future__ import annotations
 

@@ -205,13 +205,13 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     The runs of consecutive points Hill calls unstable are checked with :func:`check_point`,
     the shortest runs first, ``MAX_CONFIRM`` checks and more while they have taken less than
     ``CONFIRM_SECONDS`` or ``CONFIRM_SHARE`` of the time Hill's spectra took
-    (``settings["stability_seconds"]`` on entry).  A run of at most ``LONG_RUN`` points is judged by its middle point
-    first: if Floquet confirms it (or shooting does not converge), Hill's verdict stands for
-    the run; if Floquet calls it stable, every point of the run is checked and a converged
-    Floquet verdict replaces Hill's.  A longer run is checked at ``RUN_SAMPLES`` points
-    spread over it (:func:`_sampled_run`).  Each *island* of at most ``LONG_RUN`` points Hill
-    calls stable between two unstable points is checked as a short run, in the same order of
-    length, a converged unstable Floquet verdict replacing Hill's
+    (``settings["stability_seconds"]`` on entry).  A run of at most ``LONG_RUN`` points is
+    judged by its middle point first: if Floquet confirms it (or shooting does not converge),
+    Hill's verdict stands for the run; if Floquet calls it stable, every point of the run is
+    checked and a converged Floquet verdict replaces Hill's.  A longer run is checked at
+    ``RUN_SAMPLES`` points spread over it (:func:`_sampled_run`).  Each *island* of at most
+    ``LONG_RUN`` points Hill calls stable between two unstable points is checked as a short
+    run, in the same order of length, a converged unstable Floquet verdict replacing Hill's
     (``settings["floquet_unstable_hz"]``).  The checks take ``CONFIRM_STEPS`` steps per
     period, ``FINE_STEPS`` on a model with stiff contacts (``settings["floquet_steps"]``).
     ``settings["floquet_checked"]`` counts the checks, ``settings["floquet_overrides_hz"]``
@@ -240,19 +240,17 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     steps = settings["floquet_steps"] = FINE_STEPS if stiff_contacts(case) else CONFIRM_STEPS
     budget = _Budget(max(CONFIRM_SECONDS, CONFIRM_SHARE * settings.get("stability_seconds", 0.0)))
 
-    def stable_at(i):
-        """Floquet's verdict at point ``i`` (True: converged and stable), or None past the cap."""
-        if not budget.take():
-            return None
-        c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
-        return bool(c.converged and c.stable)
+    def floquet_calls(verdict: bool):
+        """``turns(i)``: True where shooting converged and Floquet's verdict at point ``i`` is
+        ``verdict`` (True: stable), None past the cap."""
+        def turns(i):
+            if not budget.take():
+                return None
+            c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
+            return bool(c.converged and c.stable == verdict)
+        return turns
 
-    def unstable_at(i):
-        """True where Floquet calls point ``i`` unstable (converged), None past the cap."""
-        if not budget.take():
-            return None
-        c = check_point(case, basis, Xs[i], float(freq_hz[i]), steps=steps, problem=problem)
-        return bool(c.converged and not c.stable)
+    stable_at, unstable_at = floquet_calls(True), floquet_calls(False)
 
     out, turned, lost, unchecked = stable.copy(), [], set(), 0
     runs = [(r, False) for r in np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)]
