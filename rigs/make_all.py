@@ -16,7 +16,8 @@ HERE = Path(__file__).resolve().parent
 RIGS = {
     "cross_beam": ("rigs/make_cross_beam_model.py", ["rigs/studies/cross_beam_study.py"]),
     "railcar_wedge": ("rigs/make_railcar_wedge_model.py", ["rigs/studies/railcar_wedge_sweep.py",
-                                                           "rigs/studies/railcar_table3.py"]),
+                                                           "rigs/studies/railcar_table3.py",
+                                                           "rigs/studies/railcar_rigid_study.py"]),
     "blade_couple": (None, ["rigs/make_blade_couple.py"]),
     "beam_damper_beam": ("rigs/make_beam_damper_beam_model.py",
                          ["benchmarks/beam_damper_beam_study.py", "benchmarks/beam_damper_beam_bar.py",
