@@ -110,3 +110,26 @@ def test_rig_numbers_quoted_in_the_document():
     assert [e.duration for e in ev] == pytest.approx([11.83e-3, 11.85e-3], abs=0.02e-3)
     st = rr.steady_state(rr.Rig.at(28.0, 0.22e-3, mu_k=0.2, mu_s=0.29))
     assert st.converged and st.multiple == 2
+
+
+@pytest.mark.parametrize("freq", [31.0, 40.0])
+def test_energy_balance_over_a_period(freq):
+    # split Eq. (1) into the frictionless law (mu = 0: conservative plus the side-frame's
+    # inertial load) and the friction's part; over a steady period the load's work must be
+    # what friction dissipates (stuck phases do no work), and friction must dissipate
+    rig = rr.Rig.at(freq, 2e-4)
+    st = rr.steady_state(rig)
+    F0, G0, H0 = rr.Rig.at(freq, 2e-4, mu_k=0.0).slip[1]
+    n = 200_000
+    t = (np.arange(n) + 0.5) * rig.period / n              # midpoint rule
+    y, v = rr.sample(st.phases, t, rig.W)
+    ge = mk.G_ACC - rig.A * rig.W ** 2 * np.cos(rig.W * t)  # gravity + side-frame inertia
+    friction = np.zeros(n)
+    for s in (1, -1):
+        F, G, H = rig.slip[s]
+        m = np.sign(v) == s
+        friction[m] = -(rr.W2 * (F - F0) * y[m] + (H - H0) * mk.G_ACC + (G - G0) * ge[m])
+    dt = rig.period / n
+    w_load, w_friction = np.sum(-G0 * ge * v) * dt, np.sum(friction * v) * dt
+    assert w_friction < 0
+    assert abs(w_load + w_friction) <= 1e-7 * abs(w_friction)
