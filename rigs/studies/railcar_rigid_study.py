@@ -11,10 +11,13 @@ contacts, and where the rise of the relative motion lands.
 2. The paper's Table 3 (harmonic content) and stick events at its frequencies, for each.
 3. Contact stiffness: the penalty model of ``rigs/railcar_wedge.toml`` at 40 Hz (pure slip)
    with kt = kn = 1e6 (the rig's), 4e6, 1.6e7 and 6.4e7 N/m (``hbm.timedomain.timesim``,
-   1024 steps per period) against the rigid model.
+   1024 steps per period) against the rigid model; and over 28-40 Hz (1 Hz steps) with
+   1e6 and 6.4e7 N/m, to see where the rise goes as the contacts stiffen.
 
-Writes ``rigs/figures/railcar_rigid.png`` and ``rigs/out/railcar_rigid.csv``.
-Run: ``python rigs/studies/railcar_rigid_study.py`` (about a minute; ``--no-penalty`` skips 3).
+Writes ``rigs/figures/railcar_rigid.png``, ``rigs/out/railcar_rigid.csv`` and
+``rigs/out/railcar_rigid_penalty.csv``.
+Run: ``python rigs/studies/railcar_rigid_study.py`` (about 2 minutes; ``--no-penalty`` skips 3,
+then 20 s).
 """
 from __future__ import annotations
 
@@ -42,6 +45,8 @@ CASES = {
     "1.15 g side-frame acceleration": lambda f: rr.Rig.at(f, 1.15 * G_ACC / (2 * np.pi * f) ** 2),
 }
 STIFFNESSES = (1e6, 4e6, 1.6e7, 6.4e7)
+SWEPT = (1e6, 6.4e7)                                  # penalty sweeps over PENALTY_FREQS
+PENALTY_FREQS = np.arange(28.0, 40.001, 1.0)
 CASE = ROOT / "rigs" / "railcar_wedge.toml"
 
 
@@ -84,6 +89,29 @@ def penalty_pkpk(freq_hz: float, k: float, steps: int = 1024) -> tuple[float, bo
     return float(np.ptp(x) * 1e3), bool(run.converged)
 
 
+def penalty_runs(rigid_rows: list) -> tuple[list, dict]:
+    """The penalty model at 40 Hz for each of ``STIFFNESSES`` (against the rigid model's
+    ``rigid_rows``) and its sweeps over ``PENALTY_FREQS`` for each of ``SWEPT``."""
+    rigid = next(r["pkpk_mm"] for r in rigid_rows if r["freq_hz"] == 40.0)
+    ladder = []
+    for k in STIFFNESSES:
+        pk, ok = penalty_pkpk(40.0, k)
+        ladder.append({"k": k, "pkpk_mm": pk, "periodic": ok, "rigid_mm": rigid})
+        print(f"  penalty kt = kn = {k:.3g} N/m at 40 Hz: pk-pk {pk:.4f} mm "
+              f"({pk / rigid - 1:+.1%} from rigid {rigid:.4f}){'' if ok else ' (not periodic to 1e-6)'}",
+              flush=True)
+    penalty = {}
+    for k in SWEPT:
+        penalty[k] = []
+        for f in PENALTY_FREQS:
+            pk, ok = penalty_pkpk(float(f), k)
+            penalty[k].append({"freq_hz": float(f), "pkpk_mm": pk, "periodic": int(ok)})
+        print(f"  penalty kt = kn = {k:.3g} N/m, 28-40 Hz pk-pk (mm): "
+              + " ".join(f"{r['pkpk_mm']:.3f}{'' if r['periodic'] else '*'}" for r in penalty[k])
+              + "  (* not periodic to 1e-6)", flush=True)
+    return ladder, penalty
+
+
 def table3_rows(sweeps: dict) -> list:
     """Harmonic ratios and stick events of each case at the paper's Table 3 frequencies."""
     out = []
@@ -101,43 +129,50 @@ def table3_rows(sweeps: dict) -> list:
     return out
 
 
-def plot(sweeps: dict, penalty: list, path: Path) -> None:
-    """pk-pk against frequency (rigid cases, up and down), pk-pk at 40 Hz against the
-    contact stiffness, and one period at 30 Hz of each rigid case."""
+def plot(sweeps: dict, ladder: list, penalty: dict, path: Path) -> None:
+    """(a) pk-pk against frequency of the rigid cases, up and down; (b) the penalty model's
+    sweeps against the rigid one at the rig's amplitude; (c) pk-pk at 40 Hz against the
+    contact stiffness; (d) one period at 30 Hz of each rigid case."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(1, 3, figsize=(16, 4.8))
+    fig, axs = plt.subplots(2, 2, figsize=(13, 9))
+    ax = axs.ravel()
     for (name, rows), c in zip(sweeps.items(), ("C0", "C1", "C2", "C3")):
         up = [r for r in rows if r["direction"] == "up"]
         down = [r for r in rows if r["direction"] == "down"]
-        ax[0].plot([r["freq_hz"] for r in up], [r["pkpk_mm"] for r in up], "-", color=c,
-                   label=name)
-        ax[0].plot([r["freq_hz"] for r in down], [r["pkpk_mm"] for r in down], "o",
-                   color=c, ms=3, mfc="none")
+        ax[0].plot([r["freq_hz"] for r in up], [r["pkpk_mm"] for r in up], "-", color=c, label=name)
+        ax[0].plot([r["freq_hz"] for r in down], [r["pkpk_mm"] for r in down], "o", color=c, ms=3,
+                   mfc="none")
         st = next(r["steady"] for r in up if r["freq_hz"] == 30.0)
         t, y, _ = st.samples(1024)
-        ax[2].plot(t * 1e3, (y - y.mean()) * 1e3, color=c, label=name)
+        ax[3].plot(t * 1e3, (y - y.mean()) * 1e3, color=c, label=name)
         for e in rr.stick_events(st):
-            ax[2].axvspan(e.start * 1e3, (e.start + e.duration) * 1e3, color=c, alpha=0.12)
-    ax[0].axvspan(28.5, 30.0, color="0.85", label="paper: stick-slip")
-    ax[0].axvline(35.5, color="k", ls=":", label="paper: sharp rise beyond 35.5 Hz")
+            ax[3].axvspan(e.start * 1e3, (e.start + e.duration) * 1e3, color=c, alpha=0.12)
+    for a in ax[:2]:
+        a.axvspan(28.5, 30.0, color="0.85", label="paper: stick-slip")
+        a.axvline(35.5, color="k", ls=":", label="paper: sharp rise beyond 35.5 Hz")
     top = 1.3 * max(r["pkpk_mm"] for rows in sweeps.values() for r in rows if r["freq_hz"] >= 30)
     ax[0].set(xlabel="excitation frequency, Hz", ylabel="pk-pk relative displacement, mm",
               title="rigid contacts, sweep up (line) and down (circles)", ylim=(0, top))
-    ax[0].legend(fontsize=7)
-    if penalty:
-        k = [p["k"] for p in penalty]
-        ax[1].semilogx(k, [p["pkpk_mm"] for p in penalty], "o-", label="penalty contacts, kt = kn")
-        ax[1].axhline(penalty[0]["rigid_mm"], color="k", ls="--", label="rigid contacts")
-        ax[1].set(xlabel="contact stiffness kt = kn, N/m", ylabel="pk-pk at 40 Hz, mm",
-                  title="40 Hz (pure slip): penalty model towards the rigid one")
-        ax[1].legend(fontsize=8)
-    ax[2].set(xlabel="t, ms", ylabel="relative displacement - mean, mm",
-              title="30 Hz, one period (stick intervals shaded)")
-    ax[2].legend(fontsize=7)
+    rigid = [r for r in sweeps["A = 0.2 mm"] if r["direction"] == "up"]
+    ax[1].plot([r["freq_hz"] for r in rigid], [r["pkpk_mm"] for r in rigid], "k-", label="rigid contacts")
+    for (k, rows), c in zip(penalty.items(), ("C3", "C4")):
+        ax[1].plot([r["freq_hz"] for r in rows], [r["pkpk_mm"] for r in rows], "s--", color=c, ms=4,
+                   label=f"penalty contacts, kt = kn = {k:.3g} N/m")
+    ax[1].set(xlabel="excitation frequency, Hz", ylabel="pk-pk relative displacement, mm",
+              title="A = 0.2 mm: penalty contacts (time integration) against rigid")
+    if ladder:
+        ax[2].semilogx([p["k"] for p in ladder], [p["pkpk_mm"] for p in ladder], "o-",
+                       label="penalty contacts, kt = kn")
+        ax[2].axhline(ladder[0]["rigid_mm"], color="k", ls="--", label="rigid contacts")
+    ax[2].set(xlabel="contact stiffness kt = kn, N/m", ylabel="pk-pk at 40 Hz, mm",
+              title="40 Hz (pure slip): penalty model towards the rigid one")
+    ax[3].set(xlabel="t, ms", ylabel="relative displacement - mean, mm",
+              title="rigid contacts, 30 Hz, one period (stick intervals shaded)")
     for a in ax:
         a.grid(alpha=0.3)
+        a.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
@@ -166,15 +201,9 @@ def main(argv=None) -> None:
     for r in t3:
         print(f"  {r['case']:36s} {r['freq_hz']:5.1f} Hz paper {r['paper']:22s} ours {r['ours']:22s} "
               f"{r['sticks']}")
-    penalty = []
+    ladder, penalty = [], {}
     if not args.no_penalty:
-        rigid = next(r["pkpk_mm"] for r in sweeps["A = 0.2 mm"] if r["freq_hz"] == 40.0)
-        for k in STIFFNESSES:
-            pk, ok = penalty_pkpk(40.0, k)
-            penalty.append({"k": k, "pkpk_mm": pk, "periodic": ok, "rigid_mm": rigid})
-            print(f"  penalty kt = kn = {k:.3g} N/m at 40 Hz: pk-pk {pk:.4f} mm "
-                  f"({pk / rigid - 1:+.1%} from rigid {rigid:.4f}){'' if ok else ' (not periodic to 1e-6)'}",
-                  flush=True)
+        ladder, penalty = penalty_runs(sweeps["A = 0.2 mm"])
     out = ROOT / "rigs" / "out"
     out.mkdir(exist_ok=True)
     rows = [{"case": k, **{c: v for c, v in r.items() if c != "steady"}}
@@ -183,7 +212,12 @@ def main(argv=None) -> None:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    plot(sweeps, penalty, ROOT / "rigs" / "figures" / "railcar_rigid.png")
+    if penalty:
+        with open(out / "railcar_rigid_penalty.csv", "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=["kt_kn", "freq_hz", "pkpk_mm", "periodic"])
+            w.writeheader()
+            w.writerows({"kt_kn": k, **r} for k, rows in penalty.items() for r in rows)
+    plot(sweeps, ladder, penalty, ROOT / "rigs" / "figures" / "railcar_rigid.png")
     print(f"wrote rigs/figures/railcar_rigid.png, rigs/out/railcar_rigid.csv "
           f"({time.perf_counter() - t0:.0f} s)")
 
