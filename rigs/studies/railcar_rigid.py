@@ -35,6 +35,7 @@ periods), or by Newton on the period map where the marching converges slowly (pu
 """
 from __future__ import annotations
 
+import dataclasses
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -138,7 +139,7 @@ def slip_phase(rig: Rig, s: int, t0: float, y0: float, v0: float, horizon: float
     C1 = y0 - Yc - Yh * np.cos(rig.W * t0)
     C2 = (v0 + Yh * rig.W * np.sin(rig.W * t0)) / ws
     p = Phase(s, t0, t0 + horizon, y0, ws, Yc, Yh, C1, C2)
-    return Phase(s, t0, _first_stop(p, rig.W, t0, t0 + horizon), y0, ws, Yc, Yh, C1, C2)
+    return dataclasses.replace(p, t1=_first_stop(p, rig.W, t0, t0 + horizon))
 
 
 def _first_stop(p: Phase, W: float, t0: float, t_end: float) -> float:
@@ -193,13 +194,12 @@ def stick_phase(rig: Rig, t0: float, y0: float, horizon: float,
         P = -W2 * F * y0 - mk.G_ACC * (H + G)
         Q = G * rig.A * rig.W ** 2
         # leaves upwards where a+ = P + Q cos > 0, downwards where a- = P + Q cos < 0
-        c = -P / Q if Q > 0 else np.inf * np.sign(-P)
         if s * P > 0:                                # violated whatever the phase
             ends.append((t0, s))
             continue
-        if abs(c) >= 1:
+        if abs(P) >= Q:                              # never violated (Q = 0: no excitation)
             continue
-        th = np.arccos(c)
+        th = np.arccos(-P / Q)
         entry = 2 * np.pi - th if s == 1 else th     # where the violated arc begins
         phase0 = (rig.W * t0) % (2 * np.pi)
         inside = (phase0 > 2 * np.pi - th or phase0 < th) if s == 1 else (th < phase0 < 2 * np.pi - th)
