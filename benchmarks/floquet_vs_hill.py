@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -71,7 +72,6 @@ def with_harmonics(case, H, N):
     """``case`` on harmonics 0..``H`` with ``N`` samples (the flanks rig's contact motion,
     which its verdicts rest on, is resolved at H = 15 where the rig's H = 5 leaves it 11-14 %
     off in the IP fold while the tip is within 0.5 %)."""
-    import dataclasses
     return dataclasses.replace(case, analysis=dataclasses.replace(
         case.analysis, harmonics=np.arange(H + 1), time_samples=N))
 
