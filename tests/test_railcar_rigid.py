@@ -133,3 +133,19 @@ def test_energy_balance_over_a_period(freq):
     w_load, w_friction = np.sum(-G0 * ge * v) * dt, np.sum(friction * v) * dt
     assert w_friction < 0
     assert abs(w_load + w_friction) <= 1e-7 * abs(w_friction)
+
+
+def test_stick_types_and_a_stick_across_the_period_end():
+    # type A keeps the direction across a stick, type B reverses it (the paper's Fig. 8); a
+    # stick cut by the end of the period is joined to its start
+    rig = rr.Rig.at(30.0, 2e-4)
+    T = rig.period
+    ph = [rr.Phase(0, 0.0, 0.1 * T, 0.0), rr.Phase(1, 0.1 * T, 0.3 * T, 0.0),
+          rr.Phase(0, 0.3 * T, 0.4 * T, 0.0), rr.Phase(1, 0.4 * T, 0.6 * T, 0.0),
+          rr.Phase(0, 0.6 * T, 0.7 * T, 0.0), rr.Phase(-1, 0.7 * T, 0.9 * T, 0.0),
+          rr.Phase(0, 0.9 * T, T, 0.0)]
+    st = rr.Steady(rig, 0.0, 0.0, ph, True, "marching", 1)
+    ev = rr.stick_events(st)
+    assert [e.kind for e in ev] == ["A", "B", "B"]
+    assert [e.start / T for e in ev] == pytest.approx([0.3, 0.6, 0.9])
+    assert [e.duration / T for e in ev] == pytest.approx([0.1, 0.1, 0.2])
