@@ -253,7 +253,7 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
     stable_at, unstable_at = floquet_calls(True), floquet_calls(False)
 
     out, turned, lost, unchecked = stable.copy(), [], set(), 0
-    runs = [(r, False) for r in np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)]
+    runs = [(r, False) for r in _runs(bad)]
     for run, island in sorted(runs + [(r, True) for r in _islands(stable)], key=lambda ri: ri[0].size):
         if budget.spent():
             unchecked += 0 if island else run.size
@@ -278,9 +278,13 @@ def confirm_unstable(case, basis: FourierBasis, Xs: np.ndarray, freq_hz: np.ndar
 def _islands(stable: np.ndarray) -> list:
     """Runs (indices) of at most ``LONG_RUN`` points that Hill calls stable (``stable`` (n,))
     with an unstable point on either side (module doc)."""
-    good = np.flatnonzero(stable)
-    runs = np.split(good, np.flatnonzero(np.diff(good) > 1) + 1) if good.size else []
-    return [r for r in runs if r.size <= LONG_RUN and r[0] > 0 and r[-1] < stable.size - 1]
+    return [r for r in _runs(np.flatnonzero(stable))
+            if r.size <= LONG_RUN and r[0] > 0 and r[-1] < stable.size - 1]
+
+
+def _runs(idx: np.ndarray) -> list:
+    """The runs of consecutive indices in the sorted ``idx`` (k,), as arrays."""
+    return np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
 
 
 class _Budget:

@@ -12,10 +12,8 @@ direction :math:`s = \operatorname{sgn} \dot Y`:
     \ddot Y + \omega^2 F^s Y = -g (H^s + G^s) + G^s A W^2 \cos W t,
     \qquad \omega^2 = K_b / M_b,
 
-with :math:`F^\pm, G^\pm, H^\pm` at the kinetic friction coefficient :math:`\mu_k`
-(``make_railcar_wedge_model.kaiser_coefficients``, Table 2). While :math:`\dot Y = 0` the
-bolster sticks as long as neither direction can start, with the coefficients at the static
-coefficient :math:`\mu_s`:
+with :math:`F^\pm, G^\pm, H^\pm` at :math:`\mu_k` (``kaiser_coefficients``, Table 2). While
+:math:`\dot Y = 0` it sticks as long as neither direction can start (coefficients at :math:`\mu_s`):
 
 .. math::
 
@@ -24,20 +22,16 @@ coefficient :math:`\mu_s`:
 Every phase has a closed form. A slip phase is an undamped oscillator of frequency
 :math:`\omega \sqrt{F^s}` under a constant and a harmonic load; it ends at the first zero of
 :math:`\dot Y` (located on a grid of 1/64 of the shorter period, each sign change or
-near-zero extremum refined by Brent's method). A stick phase ends where :math:`a^+` or
-:math:`a^-` crosses zero, a cosine equation solved exactly. So stick phases are exact: no
-contact stiffness, no time step. A stick is of type A when the bolster leaves in the
-direction it came (the paper's Fig. 8), of type B when it reverses.
+near-zero extremum refined by Brent's method). A stick phase ends where :math:`a^\pm` crosses
+zero, a cosine equation solved exactly: no contact stiffness, no time step. A stick is of
+type A when the bolster leaves in the direction it came, B when it reverses (paper, Fig. 8).
 
-The periodic steady state is found by marching periods until the state at the start of a
-period repeats (stick phases forget the velocity, so this is often exact after a few
-periods), or by Newton on the period map where the marching converges slowly (pure slip).
+Steady states: periods marched until the state repeats, or Newton on the period map.
 """
 from __future__ import annotations
 
 import dataclasses
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -52,7 +46,7 @@ W2 = mk.K_B / mk.M_B          # omega^2 of the bolster on its nest, 1/s^2
 GRID = 64                     # velocity samples per shorter period in a slip phase
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Rig:
     """The one-DOF rig at one excitation.
 
@@ -81,6 +75,18 @@ class Rig:
     def period(self) -> float:
         return 2 * np.pi / self.W
 
+    @property
+    def scale(self) -> np.ndarray:
+        """Scales of the state (y, v): ``(A, A W)``."""
+        return np.array([self.A, self.A * self.W])
+
+    def stick_test(self, s: int, y: float) -> tuple[float, float]:
+        """``(P, Q)`` with ``a(t) = P + Q cos(W t)``: the acceleration the bolster stuck at
+        ``y`` would start with in direction ``s`` (static coefficients); it leaves upwards
+        where ``a`` of ``s = 1`` is positive, downwards where that of ``s = -1`` is negative."""
+        F, G, H = self.stick[s]
+        return -W2 * F * y - mk.G_ACC * (H + G), G * self.A * self.W ** 2
+
     def drive(self, s: int, t, stick: bool = False):
         """Acceleration of the bolster at rest at ``Y = 0`` under the law of direction ``s``
         (the right-hand side of Eq. (1)); (len(t),) or scalar."""
@@ -88,7 +94,7 @@ class Rig:
         return -mk.G_ACC * (H + G) + G * self.A * self.W ** 2 * np.cos(self.W * t)
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Phase:
     """One phase from ``t0`` to ``t1``: ``s = 0`` stuck at ``y0``; ``s = +-1`` slipping with
     ``Y(t) = Yc + Yh cos(W t) + C1 cos(ws (t - t0)) + C2 sin(ws (t - t0))``."""
@@ -190,10 +196,7 @@ def stick_phase(rig: Rig, t0: float, y0: float, horizon: float,
     condition is violated on now is passed over."""
     ends = []
     for s in (1, -1):
-        F, G, H = rig.stick[s]
-        P = -W2 * F * y0 - mk.G_ACC * (H + G)
-        Q = G * rig.A * rig.W ** 2
-        # leaves upwards where a+ = P + Q cos > 0, downwards where a- = P + Q cos < 0
+        P, Q = rig.stick_test(s, y0)
         if s * P > 0:                                # violated whatever the phase
             ends.append((t0, s))
             continue
@@ -217,12 +220,11 @@ def stick_phase(rig: Rig, t0: float, y0: float, horizon: float,
 def next_direction(rig: Rig, t: float, y: float) -> int:
     """Direction after the velocity reaches zero at ``(t, y)``: 0 to stick, else the sign of
     the motion that starts (with the static coefficients for the stick test)."""
-    up = rig.drive(1, t, stick=True) - W2 * rig.stick[1][0] * y
-    down = rig.drive(-1, t, stick=True) - W2 * rig.stick[-1][0] * y
-    if up > 0:
-        return 1
-    if down < 0:
-        return -1
+    c = np.cos(rig.W * t)
+    for s in (1, -1):
+        P, Q = rig.stick_test(s, y)
+        if s * (P + Q * c) > 0:
+            return s
     return 0
 
 
@@ -272,7 +274,7 @@ def period_map(rig: Rig, y: float, v: float, t0: float = 0.0):
 Y_STATIC = mk.static_equilibrium()[0]     # bolster at rest, frictionless equilibrium, m
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Steady:
     """A periodic steady state (or the last period marched): the state ``(y0, v0)`` at
     ``t = 0``, the phases of one period of the motion (``multiple`` excitation periods),
@@ -303,20 +305,21 @@ class Steady:
         return (t, *sample(self.phases, t, self.rig.W))
 
 
+def _after(rig: Rig, z: np.ndarray) -> np.ndarray:
+    """The state (y, v) one period after ``z``."""
+    return np.array(period_map(rig, *z)[:2])
+
+
 def _shoot(rig: Rig, y: float, v: float, tol: float, iters: int = 12):
     """Newton on ``P(z) = z`` for the period map ``P`` from ``z = (y, v)`` (Jacobian by
     finite differences); the solution, or None."""
-    scale = np.array([rig.A, rig.A * rig.W])
     z = np.array([y, v])
     for _ in range(iters):
-        r = np.array(period_map(rig, *z)[:2]) - z
-        J = np.empty((2, 2))
-        for j in range(2):
-            dz = np.zeros(2)
-            dz[j] = 1e-7 * scale[j]
-            J[:, j] = (np.array(period_map(rig, *(z + dz))[:2]) - z - dz - r) / dz[j]
-        if np.all(np.abs(r) <= tol * scale):
+        r = _after(rig, z) - z
+        if np.all(np.abs(r) <= tol * rig.scale):
             return z
+        J = np.column_stack([(_after(rig, z + dz) - z - dz - r) / dz[j]
+                             for j, dz in enumerate(np.diag(1e-7 * rig.scale))])
         try:
             z = z - np.linalg.solve(J, r)
         except np.linalg.LinAlgError:
@@ -331,13 +334,12 @@ def steady_state(rig: Rig, tol: float = 1e-10, settle: int = 200, max_periods: i
     period, or after ``n <= longest`` (a subharmonic motion); after ``settle`` periods
     without that, Newton on the period map is tried from where the march is, then marching
     goes on up to ``max_periods``."""
-    scale = np.array([rig.A, rig.A * rig.W])
     states = [np.array([y0, v0])]
     for k in range(1, max_periods + 1):
         y1, v1, phases = period_map(rig, *states[-1])
         states.append(np.array([y1, v1]))
         for n in range(1, min(longest, k) + 1):
-            if np.all(np.abs(states[-1] - states[-1 - n]) <= tol * scale):
+            if np.all(np.abs(states[-1] - states[-1 - n]) <= tol * rig.scale):
                 y, v = states[-1 - n]
                 if n > 1:
                     phases = march(rig, 0.0, y, v, n * rig.period)
@@ -356,14 +358,13 @@ def _attracts(rig: Rig, z: np.ndarray, periods: int) -> bool:
     """Whether a perturbation of 1e-6 of ``(A, A W)`` of the periodic state ``z`` = (y, v)
     stays below twice that after ``periods`` periods (a multiplier above about
     ``2 ** (1 / periods)`` fails)."""
-    scale = np.array([rig.A, rig.A * rig.W])
-    p = z + 1e-6 * scale
+    p = z + 1e-6 * rig.scale
     for _ in range(periods):
-        p = np.array(period_map(rig, *p)[:2])
-    return bool(np.max(np.abs(p - z) / scale) <= 2e-6)
+        p = _after(rig, p)
+    return bool(np.max(np.abs(p - z) / rig.scale) <= 2e-6)
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Stick:
     """A stick event of a steady period: start time and duration (s), and its type, "A" if
     the bolster leaves in the direction it came, "B" if it reverses (the paper's Fig. 8)."""

@@ -172,7 +172,8 @@ def plot(sweeps: dict, ladder: list, penalty: dict, path: Path) -> None:
               title="rigid contacts, 30 Hz, one period (stick intervals shaded)")
     for a in ax:
         a.grid(alpha=0.3)
-        a.legend(fontsize=7)
+        if a.get_legend_handles_labels()[0]:             # empty without the penalty runs
+            a.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
