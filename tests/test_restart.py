@@ -130,17 +130,17 @@ def test_a_fresh_start_on_the_branch_already_traced_is_passed_over():
 
 
 def test_a_gap_states_how_much_the_response_changes_across_it():
-    """friction3d, force ratio 100, kt/k = 1e4, H = 5, contact closed: at the slip onset on the
-    stuck contact's needle resonance the path stops, and the restart reaches back to within
-    3e-8 of the frequency.  Across that gap the first harmonics change by 6e-6 and the whole
-    response by 0.6 %: the mean of u_t, the slider's offset once it slips (the stuck slider
-    sits at rest).  The gap states both, and they are the FRF's own values at its two ends."""
+    """friction3d, force ratio 100, kt/k = 1e4, H = 5, the contact separating: where the contact
+    opens the path stops; a restart further on and the marches at fixed frequencies from both
+    ends narrow the gap to 2e-6 Hz, across which the first harmonics change by 99 % (the lower
+    branch ends at a fold, the upper one goes on below it).  The gap states that change, and it
+    is the FRF's own values at its two ends."""
     import numpy as np
-    res = hbm.frf(hbm.case_from_dict(cases.friction3d_2dof(100.0, 1e4, 5, False)), stability=False,
+    res = hbm.frf(hbm.case_from_dict(cases.friction3d_2dof(100.0, 1e4, 5, True)), stability=False,
                   error_estimate=False)
     (g,) = res.settings["gaps"]
-    assert g["to_hz"] - g["from_hz"] < 1e-6 * g["from_hz"]
-    assert g["h1_change"] < 1e-4 and 1e-3 < g["change"] < 0.05
+    assert g["to_hz"] - g["from_hz"] < 1e-4 * g["from_hz"]
+    assert g["h1_change"] > 0.5
     assert "first harmonics" in res.settings["gap_warning"]
     a, b = (int(np.flatnonzero(res.freq_hz == g[k])[0]) for k in ("from_hz", "to_hz"))
     h1 = max(abs(o.h1[a] - o.h1[b]) / max(o.h1[a], o.h1[b]) for o in res.outputs.values())

@@ -9,7 +9,8 @@ contacts stops or leaves gaps, :func:`retry_with_events` traces the window again
 ``aft = "events"`` on them and keeps the run that covers more of it: a finished run before a
 stopped one, then the untraced width (gaps, the window's ends a stopped run did not reach, a
 hole between a folded-back start and a trace from the top) if it is at most ``SHARE`` of the
-first run's; else the first run.  ``settings["aft_retry"]`` says what was tried, what each run
+first run's, or no more than it with fewer gaps (a gap whose frequencies another part of the
+path covers leaves nothing untraced, yet it is a stop); else the first run.  ``settings["aft_retry"]`` says what was tried, what each run
 left untraced and which was kept.  A first run longer than ``RETRY_SECONDS`` is not repeated
 (it would double a long run, e.g. the railcar rig's 150 s for 0.005 Hz more): its
 ``contact_hint`` says what to try.
@@ -70,7 +71,8 @@ def retry_with_events(case, res, trace):
     alt = trace(_events_case(case, stiff))
     first, second = untraced_hz(res), untraced_hz(alt)
     done, done_alt = res.status == "finished", alt.status == "finished"
-    better = done_alt > done or (done_alt == done and second < SHARE * first)
+    fewer = len(alt.settings.get("gaps", ())) < len(res.settings.get("gaps", ()))
+    better = done_alt > done or (done_alt == done and (second < SHARE * first or (second <= first and fewer)))
     kept, other = (alt, res) if better else (res, alt)
     kept.settings["aft_retry"] = {
         "contacts": names, "untraced_hz_sampled": first, "untraced_hz_events": second,

@@ -24,6 +24,7 @@ from hbm.balance.element_outputs import element_output_series
 from hbm.timedomain.floquet_check import confirm_unstable
 from hbm.balance.fourier import FourierBasis, max_abs
 from hbm.analyses.jumps import predict_jumps
+from hbm.analyses.gap_bridge import bridge_gaps
 from hbm.analyses.curve_bends import fill_bends
 from hbm.analyses.curve_fill import fill_long_steps
 from hbm.analyses.peak_refine import refine_peaks
@@ -119,6 +120,7 @@ def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, option
     shape = (basis.n_coef, problem.n_dof)
     pts, segments, (status, message, folds, n_rej), xscale = trace_window(
         problem, case, (w_lo, w_hi), xscale, r_scale, options or ArclengthOptions(), progress, settings)
+    bridge_gaps(problem, case, pts, segments, settings, xscale, r_scale, progress)
     if status != "finished" or settings.get("gaps"):
         hint = stiff_contact_hint(case)
         if hint:
