@@ -151,6 +151,8 @@ def test_a_gap_of_no_visible_width_is_named_a_corner():
     from hbm.analyses.gaps import gap_text
     corner = gap_text({"from_hz": 15.8365, "to_hz": 15.8365 * (1 + 3e-8), "h1_change": 6e-6, "change": 6e-3})
     assert "15.8365 Hz (a corner of the path, 3e-08 of the frequency wide)" in corner and "6.0e-06" in corner
+    jump = gap_text({"from_hz": 0.13620796, "to_hz": 0.13620796 * (1 + 5e-8), "h1_change": 0.87, "change": 1.2})
+    assert "0.13620796 Hz (a jump of the path, 5e-08 of the frequency wide)" in jump
     gap = gap_text({"from_hz": 0.2087, "to_hz": 0.2221, "h1_change": 1.0, "change": 1.5})
     assert gap.startswith("0.2087..0.2221 Hz (outputs across it") and "corner" not in gap
 

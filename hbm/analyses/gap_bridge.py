@@ -252,8 +252,11 @@ def bridge_gaps(problem, case, pts, segments, settings, xscale, r_scale, progres
             del segments[k + 1]
             continue
         ia, ib = segments[k][1] - 1, segments[k + 1][0]
-        kept.append({**gap, "from_hz": pts.w[ia] / (2 * np.pi), "to_hz": min(gap["to_hz"], pts.w[ib] / (2 * np.pi)),
-                     **jump(problem.basis, pts.Y[ia], pts.Y[ib])})
+        narrowed = {"from_hz": pts.w[ia] / (2 * np.pi), "to_hz": min(gap["to_hz"], pts.w[ib] / (2 * np.pi))}
+        why = gap["reason"] if not (up or down) else (
+            f"{gap['reason']}; marched at fixed frequencies from {gap['from_hz']:.6g}..{gap['to_hz']:.6g} Hz "
+            f"to what neither march passed")
+        kept.append({**gap, **narrowed, "reason": why, **jump(problem.basis, pts.Y[ia], pts.Y[ib])})
     settings["gaps_bridged"] = record[::-1]
     settings.pop("gaps", None)
     settings.pop("gap_warning", None)

@@ -17,15 +17,19 @@ from __future__ import annotations
 
 import numpy as np
 
-CORNER = 1e-6           # a gap narrower than this share of its frequency is named a corner
+CORNER = 1e-6           # a gap narrower than this share of its frequency is named a corner or a jump
+CORNER_CHANGE = 1e-3    # ... a corner when its first harmonics change by less than this
 
 
 def gap_text(g: dict) -> str:
-    """One gap for the warning; a gap narrower than ``CORNER`` of its frequency is called a
-    corner of the path (e.g. a stuck slider's offset that jumps when it starts to slip)."""
+    """One gap for the warning.  A gap narrower than ``CORNER`` of its frequency is a corner of
+    the path when the first harmonics hardly change across it (below ``CORNER_CHANGE``: e.g. a
+    stuck slider's offset that jumps when it starts to slip), else a jump of the path (its two
+    sides meet at no frequency: a fold's two branches)."""
     width = (g["to_hz"] - g["from_hz"]) / g["from_hz"]
+    kind = "a corner of the path" if g["h1_change"] < CORNER_CHANGE else "a jump of the path"
     where = (f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz" if width >= CORNER else
-             f"{g['from_hz']:.8g} Hz (a corner of the path, {width:.0e} of the frequency wide)")
+             f"{g['from_hz']:.8g} Hz ({kind}, {width:.0e} of the frequency wide)")
     return f"{where} (outputs across it: first harmonics {g['h1_change']:.1e}, whole response {g['change']:.1e})"
 
 
