@@ -38,9 +38,12 @@ march reached and stated as before (:mod:`hbm.analyses.gaps`); a fold inside it 
 solutions at one frequency: the march arrives on another one) is such a gap.
 
 What a bridge does not show: the path between two accepted points is taken as continuous, as
-between two continuation steps, with each step's change bounded as above.  Its points are
-harmonic-balance solutions at the case's harmonics; where the truncation is poor (the ringing
-above), their truncation estimates say so (:mod:`hbm.analyses.truncation`).
+between two continuation steps, with each step's change bounded as above; a fold whose other
+branch lies closer than that bound (the rate grows as a fold nears) could be stepped across
+without its middle branch.  The points are harmonic-balance solutions at the case's
+harmonics, with their own stability verdicts and truncation estimates (on the railcar rig the
+marched stretch is unstable at every point; where the truncation is poor, the estimates say
+so, :mod:`hbm.analyses.truncation`).
 """
 from __future__ import annotations
 
