@@ -109,3 +109,12 @@ def test_a_gap_not_matching_two_segments_is_kept_as_it_is():
     case = type("C", (), {"analysis": type("A", (), {"max_points": 100})()})()
     gap_bridge.bridge_gaps(None, case, pts, [[0, 1], [1, 2]], settings, None, 1.0)
     assert settings["gaps"][0]["from_hz"] == 1.0 and settings["gaps_bridged"] == [] and len(pts.w) == 2
+
+
+def test_the_console_says_what_the_marches_did(capsys):
+    from hbm.interface.frf_console import _print_notes
+    _print_notes({"gaps_bridged": [{"from_hz": 1.0, "to_hz": 1.1, "points": 14, "joined": True},
+                                   {"from_hz": 2.0, "to_hz": 2.1, "points": 3, "joined": False}]})
+    out = capsys.readouterr().out
+    assert "2 stop(s) of the continuation marched across at fixed frequencies (17 points)" in out
+    assert "1 joined the path again, 1 narrowed" in out

@@ -54,6 +54,27 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
             print(f"  warning: {st[key]}", file=sys.stderr)
     if summary["max_energy_error"] is not None:
         print(f"  max energy-balance error {summary['max_energy_error']:.2e}")
+    _print_notes(st)
+    if st.get("stuck_points"):
+        print(f"  note: at {st['stuck_points']} points a contact sticks for the whole period: its slider offset, "
+              f"hence the mean and max |y|, is one of a family of periodic solutions (column stuck_contacts)")
+    for name, v in (st.get("error_estimate") or {}).get("max", {}).items():
+        if v["error"] == 0.0:
+            print(f"  estimated error of {name}_h1 0 at every point (the richer harmonics add nothing)")
+        else:
+            print(f"  largest estimated error of {name}_h1 {v['error']:.1e} at {v['freq_hz']:.6g} Hz "
+                  f"(harmonic truncation)")
+
+
+def _print_notes(st) -> None:
+    """What the run did beside the trace: marches across gaps, the events retry, the time
+    fill, the Floquet checks."""
+    if st.get("gaps_bridged"):
+        b = st["gaps_bridged"]
+        joined = sum(g["joined"] for g in b)
+        print(f"  note: {len(b)} stop(s) of the continuation marched across at fixed frequencies "
+              f"({sum(g['points'] for g in b)} points): {joined} joined the path again"
+              + ("" if joined == len(b) else f", {len(b) - joined} narrowed (the gaps above)"))
     if st.get("aft_retry"):
         print(f"  note: {st['aft_retry']['note']}")
     if st.get("time_fill"):
@@ -73,15 +94,6 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
         print(f"  note: {st['floquet_unchecked']} point(s) Hill calls unstable were not checked by Floquet "
               f"multipliers (the checks stop past 40 and 30 s per FRF, or a quarter of Hill's time if longer): "
               f"their verdicts are Hill's")
-    if st.get("stuck_points"):
-        print(f"  note: at {st['stuck_points']} points a contact sticks for the whole period: its slider offset, "
-              f"hence the mean and max |y|, is one of a family of periodic solutions (column stuck_contacts)")
-    for name, v in (st.get("error_estimate") or {}).get("max", {}).items():
-        if v["error"] == 0.0:
-            print(f"  estimated error of {name}_h1 0 at every point (the richer harmonics add nothing)")
-        else:
-            print(f"  largest estimated error of {name}_h1 {v['error']:.1e} at {v['freq_hz']:.6g} Hz "
-                  f"(harmonic truncation)")
 
 
 def _defaults_note(st) -> str:
