@@ -10,10 +10,10 @@ contacts stops or leaves gaps, :func:`retry_with_events` traces the window again
 stopped one, then the untraced width (gaps, the window's ends a stopped run did not reach, a
 hole between a folded-back start and a trace from the top) if it is at most ``SHARE`` of the
 first run's, or no more than it with fewer gaps (a gap whose frequencies another part of the
-path covers leaves nothing untraced, yet it is a stop); else the first run.  ``settings["aft_retry"]`` says what was tried, what each run
-left untraced and which was kept.  A first run longer than ``RETRY_SECONDS`` is not repeated
-(it would double a long run, e.g. the railcar rig's 150 s for 0.005 Hz more): its
-``contact_hint`` says what to try.
+path covers leaves nothing untraced, yet it is a stop); else the first run.
+``settings["aft_retry"]`` says what was tried, what each run left untraced and which was
+kept.  A first run longer than ``RETRY_SECONDS`` is not repeated (it would double a long run,
+e.g. the railcar rig's 150 s for 0.005 Hz more): its ``contact_hint`` says what to try.
 """
 from __future__ import annotations
 

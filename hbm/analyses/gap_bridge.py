@@ -121,11 +121,11 @@ def _kink(faster: list, change: float) -> bool:
     return bool(faster) and change <= MAX_CHANGE and KINK[0] <= change / faster[-1] <= KINK[1]
 
 
-def _continues(change: float, rate: float | None, dp: float) -> bool:
-    """Whether a step of ``dp`` in the parameter that moved the unknowns by ``change``
-    (relative) continues the path: at most ``MAX_CHANGE``, and at most ``RATE_FACTOR`` times
-    what the last step's rate of change ``rate`` (None: unknown) predicts, or round-off."""
-    return change <= MAX_CHANGE and (rate is None or change <= max(RATE_FACTOR * rate * dp, ROUND_OFF))
+def _continues(change: float, rate: float | None, dw: float) -> bool:
+    """Whether a step of ``dw`` (rad/s) that moved the unknowns by ``change`` (relative)
+    continues the path: at most ``MAX_CHANGE``, and at most ``RATE_FACTOR`` times what the last
+    step's rate of change ``rate`` (per rad/s; None: unknown) predicts, or round-off."""
+    return change <= MAX_CHANGE and (rate is None or change <= max(RATE_FACTOR * rate * dw, ROUND_OFF))
 
 
 def march(m: _Marcher, start, w_end: float, target=None, rate=None):
@@ -242,14 +242,15 @@ def bridge_gaps(problem, case, pts, segments, settings, xscale, r_scale, progres
             continue
         ia, ib = segments[k][1] - 1, segments[k + 1][0]
         rates = (_rate(pts, problem, ia, ia - 1, segments[k]), _rate(pts, problem, ib, ib + 1, segments[k + 1]))
-        up, down, joined = _bridge(_Marcher(problem, xscale, r_scale),
+        budget = min(MAX_SOLVES, case.analysis.max_points - len(pts.w))     # a point costs a solve at least
+        up, down, joined = _bridge(_Marcher(problem, xscale, r_scale, budget),
                                    _v(pts, problem, ia), _v(pts, problem, ib), rates)
         pts.insert(ib, segments, k + 1, _as_points(problem, case, down[::-1]), 0, len(down))
         pts.insert(ib, segments, k, _as_points(problem, case, up), 0, len(up))
         record.append({"from_hz": gap["from_hz"], "to_hz": gap["to_hz"], "points": len(up) + len(down),
                        "joined": joined})
         if progress is not None and (up or down):
-            progress(len(pts.w), pts.w[ib] / (2 * np.pi))
+            progress(len(pts.w), float((down or up)[-1][0][-1]) / (2 * np.pi))
         if joined:
             segments[k][1] = segments[k + 1][1]
             del segments[k + 1]
