@@ -44,9 +44,7 @@ def insert_point(problem, pts, segments, k, at, X, w, its, Y) -> None:
     """Insert the solved point ``(X, w)`` with outputs ``Y`` at path index ``at`` of segment
     ``k`` (its energy error and loop closure taken here); later segments shift by one."""
     one = TracedPoints()
-    for name, v in zip(TracedPoints.FIELDS, (X, w, Y, its, energy_balance(problem, X, w).relative_error,
-                                      problem.nl.last_unclosed)):
-        getattr(one, name).append(v)
+    one.append(X, w, Y, its, energy_balance(problem, X, w).relative_error, problem.nl.last_unclosed)
     pts.insert(at, segments, k, one, 0, 1)
 
 

@@ -50,11 +50,10 @@ from __future__ import annotations
 import numpy as np
 
 from hbm.analyses.gaps import jump, state_gaps
-from hbm.analyses.polish import POLISH_ENERGY, polish, refused
+from hbm.analyses.curve_fill import solve_near
+from hbm.analyses.polish import closed_balance, refused
 from hbm.analyses.problem_setup import recover_outputs
 from hbm.analyses.traced_points import TracedPoints
-from hbm.balance.energy import energy_balance
-from hbm.balance.newton import newton
 
 FIRST_SHARE = 1.0 / 32.0    # first step, share of the span
 MIN_SHARE = 1e-4            # smallest step, share of the span
@@ -85,19 +84,13 @@ class _Marcher:
         open, :attr:`hbm.balance.aft.NonlinearForces.last_unclosed`) or None."""
         self.budget -= 1
         problem, w = self.problem, float(guess[-1])
-        fun = lambda u: problem.residual(problem.expand(u), w)[:2]      # noqa: E731
-        res = newton(fun, guess[:-1], scale=self.xscale, r_scale=self.r_scale, overwrite_jacobian=True,
-                     blocks=problem.solver_structure())
-        if not res.converged or not np.all(np.isfinite(res.x)):
+        got = solve_near(problem, problem.expand(guess[:-1]), w, np.inf, self.xscale, self.r_scale)
+        if got is None or not np.all(np.isfinite(got[0])):
             return None
-        X = problem.expand(res.x)
-        eb = energy_balance(problem, X, w)
-        err, floor = eb.relative_error, 0.0
-        if err > POLISH_ENERGY:
-            X, err, floor = polish(problem, X, w, self.xscale, self.r_scale, eb)
+        X, err, floor = closed_balance(problem, got[0], w, self.xscale, self.r_scale)
         if refused(err, floor):
             return None
-        return np.r_[problem.unknowns(X), w], res.iterations, err, problem.nl.last_unclosed
+        return np.r_[problem.unknowns(X), w], got[1], err, problem.nl.last_unclosed
 
 
 def _steps(h, h_min, span, left):
@@ -184,8 +177,7 @@ def _as_points(problem, case, marched) -> TracedPoints:
     out = TracedPoints()
     for v, its, err, unclosed in marched:
         X, w = problem.expand(v[:-1]), float(v[-1])
-        for name, val in zip(TracedPoints.FIELDS, (X, w, recover_outputs(problem, case, X, w), its, err, unclosed)):
-            getattr(out, name).append(val)
+        out.append(X, w, recover_outputs(problem, case, X, w), its, err, unclosed)
     return out
 
 

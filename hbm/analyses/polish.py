@@ -72,6 +72,16 @@ def polish(problem, X, w, xscale, r_scale, eb, linear_solve=None, w_scale=1.0):
     return X, err, 0.0
 
 
+def closed_balance(problem, X, w, xscale, r_scale, linear_solve=None, w_scale=1.0):
+    """The converged point ``(X, w)`` with its energy balance checked, polished
+    (:func:`polish`) when looser than ``POLISH_ENERGY``: ``(X, relative_error, resolution)``;
+    :func:`refused` on the last two says whether the FRF may report it."""
+    eb = energy_balance(problem, X, w)
+    if eb.relative_error <= POLISH_ENERGY:
+        return X, eb.relative_error, 0.0
+    return polish(problem, X, w, xscale, r_scale, eb, linear_solve, w_scale)
+
+
 def balance_resolution(problem, X, w, eb) -> float:
     """The energy balance's resolution at ``(X, w)`` (the linear part's share of the
     imbalance, :meth:`hbm.balance.residual.HarmonicBalance.energy_resolution`) in the measure of

@@ -20,7 +20,7 @@ import numpy as np
 from continuation import Arclength
 
 from hbm.analyses.gaps import jump, state_gaps
-from hbm.analyses.polish import ENERGY_LIMIT, POLISH_ENERGY, balance_resolution, polish, refused
+from hbm.analyses.polish import ENERGY_LIMIT, balance_resolution, closed_balance, refused
 from hbm.analyses.problem_setup import _first_point, recover_outputs
 from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
 from hbm.balance.energy import energy_balance
@@ -65,22 +65,15 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     for pt in solver:
         X = problem.expand(pt.x[:-1])
         w = float(pt.x[-1])
-        eb = energy_balance(problem, X, w)
-        err, floor = eb.relative_error, 0.0
-        if err > POLISH_ENERGY:
-            X, err, floor = polish(problem, X, w, xscale, r_scale, eb, solver.linear_solve, scale[-1])
+        X, err, floor = closed_balance(problem, X, w, xscale, r_scale, solver.linear_solve, scale[-1])
         if refused(err, floor):
             return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
                     f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "
                     f"after polishing, resolution there {floor:.1e}); the {len(pts.w)} points before it "
                     f"are kept",
                     [f / (2 * np.pi) for f in solver.folds], solver.n_rejected)
-        pts.X.append(X)
-        pts.w.append(w)
-        pts.Y.append(recover_outputs(problem, case, X, w))
-        pts.its.append(pt.iterations if pts.w[1:] else it0 + pt.iterations)
-        pts.err.append(err)
-        pts.unclosed.append(problem.nl.last_unclosed)    # of the energy balance's force call at X
+        pts.append(X, w, recover_outputs(problem, case, X, w), pt.iterations if pts.w else it0 + pt.iterations,
+                   err, problem.nl.last_unclosed)        # of the energy balance's force call at X
         if progress is not None:
             progress(offset + len(pts.w), w / (2 * np.pi))
         if offset + len(pts.w) >= case.analysis.max_points:

@@ -15,6 +15,12 @@ class TracedPoints:
     def __init__(self):
         self.X, self.w, self.Y, self.its, self.err, self.unclosed = [], [], [], [], [], []
 
+    def append(self, X, w, Y, its, err, unclosed) -> None:
+        """Add one point: coefficients (n_coef, n), rad/s, outputs (n_coef, n_out), Newton
+        iterations, energy error, the balance's loops left open."""
+        for name, v in zip(self.FIELDS, (X, w, Y, its, err, unclosed)):
+            getattr(self, name).append(v)
+
     def extend(self, other: "TracedPoints", skip_first: bool = False, reverse: bool = False) -> None:
         """Append ``other``'s points, in order or with ``reverse`` in reverse order (without its
         first point if ``skip_first``)."""
