@@ -40,6 +40,22 @@ def untraced_hz(res) -> float:
     return sum(b - a for a, b in untraced_stretches(res))
 
 
+def better_run(res, alt) -> bool:
+    """True if ``alt`` covers more of the window than ``res`` (module doc): finished before
+    stopped, then at most ``SHARE`` of the untraced width, or no more of it with fewer gaps."""
+    first, second = untraced_hz(res), untraced_hz(alt)
+    done, done_alt = res.status == "finished", alt.status == "finished"
+    fewer = len(alt.settings.get("gaps", ())) < len(res.settings.get("gaps", ()))
+    return done_alt > done or (done_alt == done and (second < SHARE * first or (second <= first and fewer)))
+
+
+def traced_case(case, res):
+    """The case ``res`` was traced on: ``case``, or its events copy when the events run was kept."""
+    if (res.settings.get("aft_retry") or {}).get("kept") == "events":
+        return _events_case(case, stiff_sampled_contacts(case))
+    return case
+
+
 def _events_case(case, stiff):
     """A copy of ``case`` whose stiff sampled contacts ``stiff`` use ``aft = "events"``."""
     elements = list(case.elements)
@@ -70,9 +86,7 @@ def retry_with_events(case, res, trace):
     names = ", ".join(case.elements[i].name for i, _ in stiff)
     alt = trace(_events_case(case, stiff))
     first, second = untraced_hz(res), untraced_hz(alt)
-    done, done_alt = res.status == "finished", alt.status == "finished"
-    fewer = len(alt.settings.get("gaps", ())) < len(res.settings.get("gaps", ()))
-    better = done_alt > done or (done_alt == done and (second < SHARE * first or (second <= first and fewer)))
+    better = better_run(res, alt)
     kept, other = (alt, res) if better else (res, alt)
     kept.settings["aft_retry"] = {
         "contacts": names, "untraced_hz_sampled": first, "untraced_hz_events": second,

@@ -33,6 +33,7 @@ from hbm.analyses.problem_setup import (_first_point, _residual_scale, check_bou
                             recover_outputs, resolve_settings, setting_sources, solve_at)
 from hbm.analyses.result import FRFResult, OutputSeries
 from hbm.analyses.aft_retry import retry_with_events, stiff_sampled_contacts
+from hbm.analyses.harmonics_retry import retry_with_harmonics
 from hbm.analyses.stability import StabilityOptions
 from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.verdicts import landing_solver, path_verdicts
@@ -66,7 +67,8 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         stability_options: StabilityOptions | None = None, error_estimate: bool = True) -> FRFResult:
     """Trace the FRF of ``case``; a run that stops or leaves gaps with stiff sampled contacts is
     traced again on their event-based AFT and the run covering more of the window is kept
-    (:mod:`hbm.analyses.aft_retry`).
+    (:mod:`hbm.analyses.aft_retry`); one that still stops where its harmonics are inadequate,
+    on richer harmonics (:mod:`hbm.analyses.harmonics_retry`).
 
     Parameters
     ----------
@@ -96,10 +98,12 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
         Always returned, also when the continuation fails (``status``/``message`` say why,
         with every point converged so far).
     """
-    def trace(c):
-        return _trace_frf(c, harmonics, samples, fmin, fmax, transform, progress, options, stability,
+    def trace(c, h=harmonics, n=samples):
+        return _trace_frf(c, h, n, fmin, fmax, transform, progress, options, stability,
                           stability_options, error_estimate)
-    return retry_with_events(case, trace(case), trace)
+    def events_retried(h, n):
+        return retry_with_events(case, trace(case, h, n), lambda c: trace(c, h, n))
+    return retry_with_harmonics(case, events_retried(harmonics, samples), events_retried, samples, harmonics)
 
 
 def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, options, stability,

@@ -49,7 +49,7 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
                 print(f"  jump {name} (sweep {way}) at {j['from_hz']:.6g} Hz: "
                       f"{j['amplitude_before']:.6g} -> {after}")
     for key in ("gap_warning", "contact_hint", "stability_warning", "closure_warning", "truncation_warning",
-                "harmonics_note"):
+                "harmonics_note", "harmonics_hint"):
         if st.get(key):
             print(f"  warning: {st[key]}", file=sys.stderr)
     if summary["max_energy_error"] is not None:
@@ -75,8 +75,9 @@ def _print_notes(st) -> None:
         print(f"  note: {len(b)} stop(s) of the continuation marched across at fixed frequencies "
               f"({sum(g['points'] for g in b)} points): {joined} joined the path again"
               + ("" if joined == len(b) else f", {len(b) - joined} narrowed (the gaps above)"))
-    if st.get("aft_retry"):
-        print(f"  note: {st['aft_retry']['note']}")
+    for key in ("aft_retry", "harmonics_retry"):
+        if st.get(key):
+            print(f"  note: {st[key]['note']}")
     if st.get("time_fill"):
         print(f"  note: {st['time_fill']['note']}")
     elif st.get("time_fill_note"):
