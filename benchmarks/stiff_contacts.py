@@ -4,7 +4,8 @@ Each case runs ``hbm.frf`` with its defaults (stability off, as the issue ran th
 more with ``aft = "events"`` (exact switches, no sampling); where a run stops, leaves gaps or
 has points estimated over 20 % off, the time fill of ``hbm frf`` (30 s) runs on it, and the
 points that settled and how far off the checked HBM points are go to the table.  Printed and
-written to benchmarks/results/stiff_contacts.csv: status, points, largest energy-balance
+written to benchmarks/results/stiff_contacts.csv: status, the harmonics of the run kept (H, richer
+than the case's where a stop was blamed on them, :mod:`hbm.analyses.harmonics_retry`), points, largest energy-balance
 error, CPU seconds, and for the Jenkins SDOF with viscous damping the largest error against
 den Hartog's closed form (viscous + Coulomb, continuous motion) over the window.
 
@@ -111,13 +112,13 @@ def main():
         res = hbm.frf(case, stability=False)
         dt = time.process_time() - t
         err = den_hartog_error(res, c) if c is not None and res.freq_hz.size else float("nan")
-        row = dict(case=name, status=res.status, points=int(res.freq_hz.size),
+        row = dict(case=name, status=res.status, H=int(max(res.basis.harmonics)), points=int(res.freq_hz.size),
                    energy_max=float(np.max(res.energy_error)) if res.freq_hz.size else float("nan"),
                    cpu_s=round(dt, 2), den_hartog_max_err=err, message=res.message)
         row["gaps"] = res.settings.get("gap_warning", "")
         row.update(time_fill(case, res))
         rows.append(row)
-        print(f"{name:42s} {res.status:9s} {row['points']:5d} pts  energy {row['energy_max']:.1e}  "
+        print(f"{name:42s} {res.status:9s} H {row['H']:2d} {row['points']:5d} pts  energy {row['energy_max']:.1e}  "
               f"{dt:6.2f} s  den Hartog {err:.2e}  time fill {row['fill_settled']}/{row['fill_points']} "
               f"(HBM off {row['fill_hbm_off'] or '-'})  {res.message[:90]}", flush=True)
     write_rows(ROOT / "benchmarks" / "results" / "stiff_contacts.csv", rows)

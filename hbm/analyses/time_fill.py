@@ -40,6 +40,7 @@ MAX_POINTS = 12         # simulations in all (stretches and checks)
 POINT_SHARE = 0.25      # a point that has not settled after this share of the budget is abandoned
 LARGE_ERROR = 0.1       # a traced point next to a stretch estimated this far off is named
 UNRELIABLE = 0.2        # traced points estimated this far off are checked in the time domain
+ROUND_OFF = 1e-12       # of fmax: a stretch this narrow is the round-off of a solved window end
 
 
 def untraced_stretches(res) -> list:
@@ -61,11 +62,12 @@ def untraced_stretches(res) -> list:
     spans = sorted((max(float(f[a:b].min()), lo), min(float(f[a:b].max()), hi))
                    for a, b in s.get("segments", [[0, f.size]]) if b > a)
     out, end = [], lo
+    tiny = ROUND_OFF * hi            # a window end solved to round-off is reached
     for a, b in spans:
-        if a > end:
+        if a > end + tiny:
             out.append((end, a))
         end = max(end, b)
-    if hi > end:
+    if hi > end + tiny:
         out.append((end, hi))
     return out
 

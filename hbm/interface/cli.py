@@ -56,7 +56,9 @@ def _positive_float(text, zero=False):
 
 
 def _add_analysis_options(p):
-    p.add_argument("--harmonics", type=_harmonics, help="H (1..H) or a comma list")
+    p.add_argument("--harmonics", type=_harmonics,
+                   help="H (1..H) or a comma list, kept as given (without it, a run that stops where the "
+                        "truncation estimate blames the harmonics is traced again on richer ones)")
     p.add_argument("--samples", type=_positive_int, help="time samples per period N")
     p.add_argument("--fmin", type=_positive_float, help="start frequency, Hz")
     p.add_argument("--fmax", type=_positive_float, help="end frequency, Hz")
