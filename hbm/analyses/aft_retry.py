@@ -49,13 +49,6 @@ def better_run(res, alt) -> bool:
     return done_alt > done or (done_alt == done and (second < SHARE * first or (second <= first and fewer)))
 
 
-def traced_case(case, res):
-    """The case ``res`` was traced on: ``case``, or its events copy when the events run was kept."""
-    if (res.settings.get("aft_retry") or {}).get("kept") == "events":
-        return _events_case(case, stiff_sampled_contacts(case))
-    return case
-
-
 def _events_case(case, stiff):
     """A copy of ``case`` whose stiff sampled contacts ``stiff`` use ``aft = "events"``."""
     elements = list(case.elements)

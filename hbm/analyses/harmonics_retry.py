@@ -72,6 +72,7 @@ def _samples_for(samples, h, factor: int):
 
 
 def _stopped(res) -> bool:
+    """The run stopped short of the window or left gaps in it."""
     return res.status != "finished" or bool(res.settings.get("gaps"))
 
 
@@ -94,8 +95,9 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
     Parameters
     ----------
     case : Case
-        The case ``res`` was traced on (with the AFT it was kept on).
+        The case (its elements' samples factor sets N where the given samples are too few).
     res : FRFResult
+        The run on the asked harmonics (after its events retry).
     trace : callable
         ``trace(harmonics, samples) -> FRFResult`` with every other setting as ``res``.
     samples : int, optional

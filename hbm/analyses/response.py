@@ -101,6 +101,7 @@ def frf(case: Case, harmonics=None, samples=None, fmin=None, fmax=None, transfor
     def trace(c, h=harmonics, n=samples):
         return _trace_frf(c, h, n, fmin, fmax, transform, progress, options, stability,
                           stability_options, error_estimate)
+
     def events_retried(h, n):
         return retry_with_events(case, trace(case, h, n), lambda c: trace(c, h, n))
     return retry_with_harmonics(case, events_retried(harmonics, samples), events_retried, samples, harmonics)
