@@ -85,6 +85,16 @@ def test_harmonics_given_as_an_argument_are_kept_and_the_next_set_named(monkeypa
     assert "--harmonics 8" in res.settings["harmonics_hint"] and "0.5" in res.settings["harmonics_hint"]
 
 
+def test_a_rung_predicted_past_the_budget_is_named_not_run(monkeypatch):
+    """20 s at H = 5 (11 coefficients) predicts (17 / 11)^3 x 20 = 74 s at H = 8: over the
+    60 s budget, so it is named with its time instead of run."""
+    assert hr.predicted_seconds(20.0, range(6), range(9)) == pytest.approx(20.0 * (17 / 11) ** 3)
+    first = _run([1.0, 2.0, 2.5, 4.0], [[0, 2], [2, 4]], [0.01, 0.4, 0.5, 0.01], seconds=20.0)
+    res, calls = _ladder(monkeypatch, first, [])
+    assert res is first and not calls and "harmonics_retry" not in res.settings
+    assert "--harmonics 8; not tried: about 74 s predicted" in res.settings["harmonics_hint"]
+
+
 def test_a_richer_run_that_covers_less_is_not_kept(monkeypatch):
     """The richer run leaves more untraced and stops where its estimate is small: the asked run
     is kept with its gap, and the note says both were tried."""

@@ -22,7 +22,8 @@ the run that covers most of the window is kept, by the rule of the events retry
 (:func:`hbm.analyses.aft_retry.better_run`).  ``settings["harmonics_retry"]`` says what was
 tried and kept; every point's harmonics are those of the run kept.  Each rung is a whole
 :func:`hbm.analyses.response.frf` trace (with its events retry); none starts once the runs so
-far took more than ``RETRY_SECONDS``, and a stop that richer harmonics do not remove (a fold
+far with its predicted time (the last run's, scaled by the cube of the unknowns' ratio) would
+take more than ``RETRY_SECONDS``, and a stop that richer harmonics do not remove (a fold
 whose branches the continuation cannot join at any of the sets tried) stays stated.
 Harmonics given as an argument (``--harmonics``, or by :func:`hbm.analyses.adaptive` for its
 richer traces) are kept as asked; the run's ``harmonics_hint`` then names the next set.
@@ -71,6 +72,15 @@ def _samples_for(samples, h, factor: int):
     return max(int(samples), default_samples(h, factor))
 
 
+def predicted_seconds(seconds: float, h_old, h_new) -> float:
+    """A run's time on ``h_new`` from ``seconds`` on ``h_old``: scaled by the cube of the ratio
+    of their coefficient counts (the dense linear algebra of a large model; small models grow
+    more slowly, so this errs on the safe side)."""
+    n = [2 * int(np.count_nonzero(np.asarray(h) > 0)) + int(np.count_nonzero(np.asarray(h) == 0))
+         for h in (h_old, h_new)]
+    return float(seconds) * (n[1] / n[0]) ** 3
+
+
 def _stopped(res) -> bool:
     """The run stopped short of the window or left gaps in it."""
     return res.status != "finished" or bool(res.settings.get("gaps"))
@@ -89,8 +99,9 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
 
     Up to ``RUNGS`` richer sets are tried, each the next after the last run's, while the last
     run still stops where its estimate blames the harmonics and the runs so far (the first's
-    solve time and each rung's wall time, its events retry included) took at most
-    ``RETRY_SECONDS``.
+    solve time and each rung's wall time, its events retry included) with the next one's
+    predicted time (:func:`predicted_seconds`) stay within ``RETRY_SECONDS``.  When even the
+    first rung would not, ``settings["harmonics_hint"]`` names it with its predicted time.
 
     Parameters
     ----------
@@ -109,15 +120,20 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
     from hbm.analyses.adaptive import carried_harmonics, next_harmonics
     if not _blames_harmonics(res):
         return res
-    if given is not None:
-        h = next_harmonics(carried_harmonics(res))
+    h = next_harmonics(carried_harmonics(res))
+    guess = predicted_seconds(res.solve_seconds, res.basis.harmonics, h)
+    if given is not None or res.solve_seconds + guess > RETRY_SECONDS:
+        why = ("with H left to the case, hbm frf tries them itself" if given is not None else
+               f"not tried: about {guess:.0f} s predicted")
         res.settings["harmonics_hint"] = (
             f"the path stopped where the estimated error of the first harmonics is {stop_error(res):.2g}: richer "
-            f"harmonics may pass it (--harmonics {max(h)}; with H left to the case, hbm frf tries them itself)")
+            f"harmonics may pass it (--harmonics {max(h)}; {why})")
         return res
-    best, last, runs, spent = res, res, [], float(res.solve_seconds)
-    while len(runs) < RUNGS and spent <= RETRY_SECONDS and _blames_harmonics(last):
+    best, last, runs, spent, secs = res, res, [], float(res.solve_seconds), float(res.solve_seconds)
+    while len(runs) < RUNGS and _blames_harmonics(last):
         h = next_harmonics(carried_harmonics(last))
+        if spent + predicted_seconds(secs, last.basis.harmonics, h) > RETRY_SECONDS:
+            break
         err = stop_error(last)
         t0 = time.perf_counter()
         last = trace(h, _samples_for(samples, h, case.analysis.samples_factor))
