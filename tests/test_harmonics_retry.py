@@ -82,7 +82,8 @@ def test_harmonics_given_as_an_argument_are_kept_and_the_next_set_named(monkeypa
     first = _run([1.0, 2.0, 2.5, 4.0], [[0, 2], [2, 4]], [0.01, 0.4, 0.5, 0.01])
     res, calls = _ladder(monkeypatch, first, [], given=5)
     assert res is first and not calls and "harmonics_retry" not in res.settings
-    assert "--harmonics 8" in res.settings["harmonics_hint"] and "0.5" in res.settings["harmonics_hint"]
+    assert "--harmonics 8;" in res.settings["harmonics_hint"] and "0.5" in res.settings["harmonics_hint"]
+    assert hr._as_argument([1, 3, 5, 7, 9]) == "1,3,5,7,9" and hr._as_argument([0, 1, 2, 3]) == "3"
 
 
 def test_a_rung_predicted_past_the_budget_is_named_not_run(monkeypatch):

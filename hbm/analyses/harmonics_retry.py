@@ -81,6 +81,13 @@ def predicted_seconds(seconds: float, h_old, h_new) -> float:
     return float(seconds) * (n[1] / n[0]) ** 3
 
 
+def _as_argument(h) -> str:
+    """``h`` as ``--harmonics`` takes it: ``H`` for 1..H, else the comma list (the mean is
+    added by the elements that need it)."""
+    pos = [int(x) for x in h if x > 0]
+    return str(max(pos)) if pos == list(range(1, max(pos) + 1)) else ",".join(map(str, pos))
+
+
 def _stopped(res) -> bool:
     """The run stopped short of the window or left gaps in it."""
     return res.status != "finished" or bool(res.settings.get("gaps"))
@@ -127,7 +134,7 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
                f"not tried: about {guess:.0f} s predicted")
         res.settings["harmonics_hint"] = (
             f"the path stopped where the estimated error of the first harmonics is {stop_error(res):.2g}: richer "
-            f"harmonics may pass it (--harmonics {max(h)}; {why})")
+            f"harmonics may pass it (--harmonics {_as_argument(h)}; {why})")
         return res
     best, last, runs, spent, secs = res, res, [], float(res.solve_seconds), float(res.solve_seconds)
     while len(runs) < RUNGS and _blames_harmonics(last):
