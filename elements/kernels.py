@@ -25,7 +25,7 @@ import numpy as np
 from numba.core import types
 from numba.extending import overload
 
-from .laws.registry import INITS, STEPS, _law_init, _law_step
+from .laws.registry import INITS, LINEARS, STEPS, _law_init, _law_linear, _law_step
 
 
 # One dispatch text, two compilations: a called kernel for the time integrator
@@ -71,6 +71,28 @@ def _law_init_of(kind, p, z0, s0, C0):
             init(p, z0, s0, C0)
         return one
     return _law_init
+
+
+def law_linear_inline(kind, p, z, K, f0):
+    """:func:`elements.law_march.linear_shortcut` inlined into compiled callers (no Python
+    implementation)."""
+    raise NotImplementedError("called from compiled code only")
+
+
+@overload(law_linear_inline, inline="always", prefer_literal=True)
+def _law_linear_of(kind, p, z, K, f0):
+    """As :func:`_law_step_of`, for the linear test (a law without one is never linear)."""
+    if isinstance(kind, types.IntegerLiteral):
+        test = LINEARS[kind.literal_value]
+        if test is None:
+            def never(kind, p, z, K, f0):
+                return False
+            return never
+
+        def one(kind, p, z, K, f0):
+            return test(p, z, K, f0)
+        return one
+    return _law_linear
 
 
 @nb.njit(cache=True)

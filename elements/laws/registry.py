@@ -8,7 +8,8 @@ laws when one march is compiled for one law).
 
 Adding a law is two files: its module in ``elements/laws/`` (kernels and, for a law on one
 coordinate, a :class:`~elements.laws.record.LawRecord`) and this one (its id, its three
-branches, its step and rest state in :data:`STEPS` and :data:`INITS`, and its record in
+branches, its step, rest state and linear test in :data:`STEPS`, :data:`INITS` and
+:data:`LINEARS`, and its record in
 :data:`CASE_LAWS` to make it a case type).
 """
 from __future__ import annotations
@@ -27,7 +28,9 @@ JENKINS, CUBIC, FRICTION3D, COULOMB_STATIC_KINETIC, COULOMB_REGULARISED, UNILATE
 # (elements.kernels.law_step_inline): the same order as KERNELS and the branches below
 STEPS = (jenkins_step, cubic_step, friction3d_step, coulomb_sk_step, coulomb_reg_step, unilateral_step)
 INITS = (jenkins_init, cubic_init, friction3d_init, coulomb_sk_init, coulomb_reg_init, unilateral_init)
-assert len(STEPS) == len(INITS) == len(KERNELS)
+# each law's linear test by id (None: it has none), for the AFT kernel of one law
+LINEARS = (jenkins_linear, None, friction3d_linear, None, None, unilateral_linear)
+assert len(STEPS) == len(INITS) == len(LINEARS) == len(KERNELS)
 
 # laws on one coordinate that are case types by their record alone (elements.law_element)
 CASE_LAWS = {CUBIC: cubic.LAW, UNILATERAL: unilateral.LAW}

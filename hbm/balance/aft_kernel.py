@@ -12,7 +12,7 @@ with coefficients ``U = X G^T`` (n_coef, n_l):
 
 with the march seeded by ``du_{j a}/dU_{m b} = E_{j m} \delta_{a b}`` (and, for velocity
 laws, ``d\dot u/dU = w E'``, ``d\dot u/dw = E' U``).  When the law is linear over the whole
-period (:func:`elements.law_march.linear_shortcut`: ``f = f_0 + K z``), the coefficients
+period (its own test, :func:`elements.kernels.law_linear_inline`: ``f = f_0 + K z``), the coefficients
 follow without marching or transforming, ``P f = K U + f_0 e_0`` (``e_0`` the mean row) and
 ``\partial (P f)/\partial U = K \otimes I``, because ``P E = I`` on an alias-free grid.
 
@@ -23,7 +23,9 @@ and closure (:func:`make_aft_law`), with the law's step inlined into the march: 
 function dispatching to both closures made numba link and re-optimise both (with their LAPACK
 calls) into it, which multiplied the first run's compile time (measured: 16 s -> 59 s CPU for
 the default rig), and a march generic in the law compiles every law and calls its step per
-sample.  The steps avoid BLAS/LAPACK bindings where loops do.
+sample; the linear test is the law's own too (the dispatch over every law's test, compiled
+into a kernel of its own, cost about 1 s of the first run).  The steps avoid BLAS/LAPACK
+bindings where loops do.
 """
 from __future__ import annotations
 
@@ -33,20 +35,18 @@ import numba as nb
 import numpy as np
 
 from elements.closure import newton_body
-from elements.kernels import march_body
-from elements.law_march import CLOSE_NEWTON, linear_shortcut, start_sample
+from elements.kernels import law_linear_inline, march_body
+from elements.law_march import CLOSE_NEWTON, start_sample
 
 
 @nb.njit(cache=True)
-def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, cols, X, w, E, dE):
-    """Coordinates, march inputs and seeds of one law, or its linear shortcut.
+def aft_coords(velocity, G, cols, X, w, E, dE):
+    """Coordinates of one law over the period.
 
     Parameters
     ----------
-    kind, p, start_rule, n_start, velocity
-        The law (:class:`elements.base.LawSpec`).
-    seeds : bool
-        Seed the march with ``dz/dU`` (and ``dz/dw``); False: no seeds (forces only).
+    velocity : bool
+        The law reads velocities too.
     G : ndarray, shape (n_l, n_g)
         The law's gather on the nonlinear DOFs ``cols`` it touches.
     cols : ndarray of int, shape (n_g,)
@@ -63,14 +63,9 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, cols, X, w, E, 
     -------
     U : ndarray, shape (n_coef, n_l)
     z : ndarray, shape (N, n_z)
-    dz : ndarray, shape (N, n_z, P)
-        ``P = n_coef n_l + 1`` with seeds, else 0.
-    start : int
-        Start sample of the march.
-    linear : bool
-        The law is linear over the period: ``f = f0 + K z`` (then ``dz`` is not filled).
-    K : ndarray, shape (n_l, n_z)
-    f0 : ndarray, shape (n_l,)
+        ``u`` (and ``w du/dphase`` for velocity laws).
+    dth : ndarray, shape (N, n_l)
+        ``du/dphase`` (zeros unless ``velocity``).
     """
     nc = X.shape[0]
     nl, nn = G.shape
@@ -98,16 +93,21 @@ def aft_inputs(kind, p, start_rule, n_start, velocity, seeds, G, cols, X, w, E, 
         for j in range(N):
             for a in range(nl):
                 z[j, nl + a] = w * dth[j, a]
-    K = np.zeros((nl, nz))
-    f0 = np.zeros(nl)
+    return U, z, dth
+
+
+@nb.njit(cache=True)
+def aft_seeds(start_rule, n_start, velocity, seeds, z, dth, w, E, dE):
+    """The march's seeds ``dz`` (N, n_z, n_coef n_l + 1; with ``seeds`` False no seed
+    columns) and its start sample by the law's rule (:func:`elements.law_march.start_sample`);
+    arguments as :func:`aft_coords` and its results."""
+    nc = E.shape[1]
+    nl = dth.shape[1]
     Pc = nc * nl + 1 if seeds else 0
-    linear = (not velocity) and linear_shortcut(kind, p, z, K, f0)
-    if linear:
-        return U, z, np.zeros((0, nz, Pc)), 0, True, K, f0
-    dz = np.empty((N, nz, Pc))
+    dz = np.empty((z.shape[0], z.shape[1], Pc))
     if seeds:
         _seed(E, dE, w, dth, velocity, dz)
-    return U, z, dz, start_sample(start_rule, n_start, z), False, K, f0
+    return dz, start_sample(start_rule, n_start, z)
 
 
 @nb.njit(cache=True)
@@ -181,7 +181,7 @@ def aft_analyse(P, f, df, G, cols, F, J4, dFdw, seeds):
     f : ndarray, shape (N, n_l)
     df : ndarray, shape (N, n_l, P_s)
     G, cols
-        The gather on the DOFs it touches (:func:`aft_inputs`).
+        The gather on the DOFs it touches (:func:`aft_coords`).
     F, dFdw : ndarray, shape (n_coef, n_nl)
         Accumulated in place (``dFdw`` only with seeds).
     J4 : ndarray, shape (n_coef, n_nl, n_coef, n_nl)
@@ -240,9 +240,10 @@ def make_aft_law(kind, closure):
     @nb.njit(cache=True)
     def run(p, n_state, start_rule, n_start, velocity, max_passes, tol, seeds,
             G, cols, X, w, E, dE, P, row0, F, J4, dFdw, f_out):
-        U, z, dz, start, linear, K, f0 = aft_inputs(kind, p, start_rule, n_start, velocity, seeds,
-                                                    G, cols, X, w, E, dE)
-        if linear:
+        U, z, dth = aft_coords(velocity, G, cols, X, w, E, dE)
+        K = np.zeros((G.shape[0], z.shape[1]))
+        f0 = np.zeros(G.shape[0])
+        if not velocity and law_linear_inline(kind, p, z, K, f0):
             aft_linear(U, K, f0, row0, G, cols, F, J4, dFdw, seeds)
             if f_out.shape[0]:
                 for j in range(z.shape[0]):
@@ -251,6 +252,7 @@ def make_aft_law(kind, closure):
                         for b in range(K.shape[1]):
                             f_out[j, a] += K[a, b] * z[j, b]
             return 0
+        dz, start = aft_seeds(start_rule, n_start, velocity, seeds, z, dth, w, E, dE)
         if newton:
             f, df, passes = newton_body(kind, p, n_state, G.shape[0], z, dz, start, max_passes, tol)
         else:
@@ -280,7 +282,7 @@ def aft_of(kind, closure):
 
 def touched(G: np.ndarray):
     """``(G_c, cols)``: the columns of ``G`` (n_l, n_nl) that are not all zero, and their
-    indices, the form the kernels take (:func:`aft_inputs`)."""
+    indices, the form the kernels take (:func:`aft_coords`)."""
     cols = np.flatnonzero(np.any(G != 0.0, axis=0)).astype(np.int64)
     return np.ascontiguousarray(G[:, cols]), cols
 
