@@ -136,11 +136,8 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
             f"the path stopped where the estimated error of the first harmonics is {stop_error(res):.2g}: richer "
             f"harmonics may pass it (--harmonics {_as_argument(h)}; {why})")
         return res
-    best, last, runs, spent, secs = res, res, [], float(res.solve_seconds), float(res.solve_seconds)
-    while len(runs) < RUNGS and _blames_harmonics(last):
-        h = next_harmonics(carried_harmonics(last))
-        if spent + predicted_seconds(secs, last.basis.harmonics, h) > RETRY_SECONDS:
-            break
+    best, last, runs, spent = res, res, [], float(res.solve_seconds)
+    while True:                     # h: the next set, its time within the budget (checked above)
         err = stop_error(last)
         t0 = time.perf_counter()
         last = trace(h, _samples_for(samples, h, case.analysis.samples_factor))
@@ -151,6 +148,11 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
                      "seconds": secs})
         if better_run(best, last):
             best = last
+        if len(runs) == RUNGS or not _blames_harmonics(last):
+            break
+        h_last, h = h, next_harmonics(carried_harmonics(last))
+        if spent + predicted_seconds(secs, h_last, h) > RETRY_SECONDS:
+            break
     H0, Hk = int(max(res.basis.harmonics)), int(max(best.basis.harmonics))
     why = "stopped" if res.status != "finished" else "left gaps"
     tried = "; ".join(f"H = {r['H']}: {r['gaps']} gap(s), {r['untraced_hz']:.3g} Hz untraced"

@@ -67,8 +67,8 @@ def print_frf(case, res, summary: dict, explicit_tol: bool) -> None:
 
 
 def _print_notes(st) -> None:
-    """What the run did beside the trace: marches across gaps, the events retry, the time
-    fill, the Floquet checks."""
+    """What the run did beside the trace: marches across gaps, the retries on events and on
+    richer harmonics, the time fill, the Floquet checks."""
     if st.get("gaps_bridged"):
         b = st["gaps_bridged"]
         joined = sum(g["joined"] for g in b)
