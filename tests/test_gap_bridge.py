@@ -27,6 +27,9 @@ class _Exact:
         u = self.path(w)
         return None if u is None else (np.r_[u, w], 3, 0.0, 0)
 
+    def change(self, new, old):
+        return gap_bridge._rel(new, old)
+
 
 def _v(path, w):
     return np.r_[path(w), w]
@@ -118,3 +121,40 @@ def test_the_console_says_what_the_marches_did(capsys):
     out = capsys.readouterr().out
     assert "2 stop(s) of the continuation marched across at fixed frequencies (17 points)" in out
     assert "1 joined the path again, 1 narrowed" in out
+
+
+def _stuck_and_slipping_points():
+    """A marcher on the friction3d point contact and one of its points per force ratio: 1e5
+    (the contact sticks the whole period) and 1 (it slips)."""
+    from hbm.analyses.problem_setup import (_first_point, _residual_scale, _unknown_scale, build_problem,
+                                            resolve_settings)
+    from hbm.balance.fourier import FourierBasis
+    out = []
+    for ratio in (1e5, 1.0):
+        case = hbm.case_from_dict(cases.friction3d_2dof(ratio, 1.0, 3, False))
+        h, N, lo, hi, tr = resolve_settings(case)
+        problem, _ = build_problem(case, FourierBasis(h, N), tr, hi)
+        w = 2 * np.pi * 0.2
+        xscale = _unknown_scale(problem, case, 2 * np.pi * lo, 2 * np.pi * hi)
+        r_scale = _residual_scale(problem, w)
+        X, _ = _first_point(problem, case, w, xscale, r_scale)
+        out.append((gap_bridge._Marcher(problem, xscale, r_scale), np.r_[problem.unknowns(X), w], problem))
+    return out
+
+
+def test_a_stuck_contacts_static_offset_is_no_change_of_the_path():
+    """Where a contact sticks the whole period its slider offset, hence the mean of the
+    solution, is one of a family: a march compares the harmonics above the mean alone there
+    (it passes the point where the contact starts to open, whose offset the motion fixes),
+    and every coefficient where the contact slips."""
+    (stuck, v, problem), (slipping, v2, _) = _stuck_and_slipping_points()
+    nc = problem.basis.n_coef
+    static = np.zeros(v.size, dtype=bool)
+    static[:-1] = np.repeat((problem.basis.h_of_row == 0)[:, None], (v.size - 1) // nc, axis=1).ravel()
+    moved = v + 0.3 * static * np.abs(v).max()
+    assert gap_bridge._rel(moved, v) > 0.05
+    assert stuck.change(moved, v) == 0.0
+    shaken = v * np.where(static, 1.0, 1.1)
+    assert np.isclose(stuck.change(shaken, v), gap_bridge._rel(shaken[~static], v[~static]))
+    moved2 = v2 + 0.3 * static * np.abs(v2).max()
+    assert slipping.change(moved2, v2) == gap_bridge._rel(moved2, v2) > 0.05

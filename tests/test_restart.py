@@ -132,9 +132,10 @@ def test_a_fresh_start_on_the_branch_already_traced_is_passed_over():
 def test_a_gap_states_how_much_the_response_changes_across_it():
     """friction3d, force ratio 100, kt/k = 1e4, H = 5, the contact separating: where the contact
     opens the path stops; a restart further on and the marches at fixed frequencies from both
-    ends narrow the gap to 2e-6 Hz, across which the first harmonics change by 99 % (the lower
-    branch ends at a fold, the upper one goes on below it).  The gap states that change, and it
-    is the FRF's own values at its two ends."""
+    ends narrow the gap to 5e-7 Hz, across which the first harmonics change by 99 % (the lower
+    branch ends at a fold, the upper one goes on below it: the arclength from the gap's upper
+    end traces it round its fold, the one from the lower end stalls short of its fold).  The gap
+    states that change, and it is the FRF's own values at its two ends."""
     import numpy as np
     res = hbm.frf(hbm.case_from_dict(cases.friction3d_2dof(100.0, 1e4, 5, True)), stability=False,
                   error_estimate=False)
@@ -145,6 +146,8 @@ def test_a_gap_states_how_much_the_response_changes_across_it():
     a, b = (int(np.flatnonzero(res.freq_hz == g[k])[0]) for k in ("from_hz", "to_hz"))
     h1 = max(abs(o.h1[a] - o.h1[b]) / max(o.h1[a], o.h1[b]) for o in res.outputs.values())
     assert abs(h1 - g["h1_change"]) < 1e-9
+    assert "traced round its fold" in g["reason"]
+    assert res.freq_hz[a + 1:b].min() < 0.99 * g["from_hz"]        # the upper branch goes on below
 
 
 def test_a_gap_of_no_visible_width_is_named_a_corner():

@@ -322,6 +322,10 @@ def test_overlay_is_not_drawn_across_an_untraced_stretch(tmp_path):
     f, a = _read_curve(tmp_path / "frf.csv", "x")
     assert f.size == 6 and np.isnan(f[3]) and np.isnan(a[3])
     assert np.array_equal(a[[0, 1, 2, 4, 5]], [1, 2, 3, 0.5, 1])
-    # without gaps (segments of restarts that left nothing untraced) the curve is whole
+    # without a gap the two segments are still two paths (a jump, or a middle branch between
+    # two folds left untraced): a line between them would draw a branch nobody traced
     (tmp_path / "summary.json").write_text(json.dumps({"settings": {"segments": [[0, 3], [3, 5]]}}))
+    assert np.isnan(_read_curve(tmp_path / "frf.csv", "x")[0][3])
+    # one segment: the curve is whole
+    (tmp_path / "summary.json").write_text(json.dumps({"settings": {"segments": [[0, 5]]}}))
     assert np.isfinite(_read_curve(tmp_path / "frf.csv", "x")[0]).all()

@@ -53,6 +53,7 @@ from hbm.analyses.gaps import jump, state_gaps
 from hbm.analyses.curve_fill import solve_near
 from hbm.analyses.polish import closed_balance, refused
 from hbm.analyses.problem_setup import recover_outputs
+from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.traced_points import TracedPoints
 
 FIRST_SHARE = 1.0 / 32.0    # first step, share of the span
@@ -77,6 +78,24 @@ class _Marcher:
 
     def __init__(self, problem, xscale, r_scale, budget=MAX_SOLVES):
         self.problem, self.xscale, self.r_scale, self.budget = problem, xscale, r_scale, budget
+        nc = problem.basis.n_coef
+        vib = np.asarray(problem.basis.h_of_row) > 0
+        self.vibrating = np.r_[np.repeat(vib[:, None], xscale.size // nc, axis=1).ravel(), True]
+        self._stuck = (None, False)
+
+    def change(self, new, old) -> float:
+        """:func:`_rel` of ``new`` against ``old`` ([u, w]), over the harmonics above the mean
+        alone when a contact sticks for the whole period at ``old``: its slider offset, hence
+        the static part of the solution, is one of a family (:mod:`hbm.analyses.stuck`), and
+        where the contact starts to open or slip the path's member of it jumps to the one the
+        motion fixes, a change that is no jump of the response."""
+        if self._stuck[0] is not old:
+            X = self.problem.expand(old[:-1])
+            n = stuck_contacts(self.problem, X[None], np.array([old[-1]]))
+            self._stuck = (old, n is not None and n[0] > 0)
+        if self._stuck[1]:
+            return _rel(new[self.vibrating], old[self.vibrating])
+        return _rel(new, old)
 
     def solve(self, guess):
         """Newton from ``guess = [u, w]`` (n_u + 1,) at its ``w``, the energy balance closed:
@@ -154,7 +173,7 @@ def march(m: _Marcher, start, w_end: float, target=None, rate=None):
             guess[-1] = at
             got = m.solve(guess)
             if got is not None and (at != w_end or target is None or _rel(got[0], target) <= MEET):
-                c = _rel(got[0], v)
+                c = m.change(got[0], v)
                 if _continues(c, rate, abs(at - v[-1])) or _kink(faster, c):
                     break
                 faster.append(c if c <= MAX_CHANGE else np.inf)
@@ -167,7 +186,7 @@ def march(m: _Marcher, start, w_end: float, target=None, rate=None):
         pts.append(got)
         if at == w_end:
             return pts, False
-        rate = _rel(got[0], v) / abs(at - v[-1])
+        rate = m.change(got[0], v) / abs(at - v[-1])
         prev, v = v, got[0]
         h = min(abs(step) * GROW, abs(w_end - v[-1]))
     return pts, False

@@ -25,6 +25,7 @@ from hbm.timedomain.floquet_check import confirm_unstable
 from hbm.balance.fourier import FourierBasis, max_abs
 from hbm.analyses.jumps import predict_jumps
 from hbm.analyses.gap_bridge import bridge_gaps
+from hbm.analyses.overhang import trace_overhangs
 from hbm.analyses.curve_bends import fill_bends
 from hbm.analyses.curve_fill import fill_long_steps
 from hbm.analyses.peak_refine import refine_peaks
@@ -37,7 +38,7 @@ from hbm.analyses.harmonics_retry import retry_with_harmonics
 from hbm.analyses.stability import StabilityOptions
 from hbm.analyses.stuck import stuck_contacts
 from hbm.analyses.verdicts import landing_solver, path_verdicts
-from hbm.analyses.trace import _step_limit, trace_window  # noqa: F401 (_step_limit: tests)
+from hbm.analyses.trace import _step_limit, trace_window
 from hbm.analyses.truncation import (MAX_UNKNOWNS, harmonics_note, largest_errors, richer_basis,
                                      truncation_errors, truncation_warning)
 
@@ -126,6 +127,8 @@ def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, option
     pts, segments, (status, message, folds, n_rej), xscale = trace_window(
         problem, case, (w_lo, w_hi), xscale, r_scale, options or ArclengthOptions(), progress, settings)
     bridge_gaps(problem, case, pts, segments, settings, xscale, r_scale, progress)
+    folds = folds + trace_overhangs(problem, case, pts, segments, settings, (w_lo, w_hi), xscale, r_scale,
+                                    options or ArclengthOptions(), _step_limit(problem, case, (w_lo, w_hi)))
     if status != "finished" or settings.get("gaps"):
         hint = stiff_contact_hint(case)
         if hint:

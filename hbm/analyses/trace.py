@@ -50,12 +50,14 @@ def _step_limit(problem, case, window) -> ResonanceStepLimit:
 
 
 def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, opts, progress, offset=0,
-           lam_step=None):
+           lam_step=None, stop=None):
     """One continuation from ``(X0, w0)`` in ``direction``; appends to ``pts``.
 
     Returns ``(status, message, folds_hz, n_rejected)``.  Points whose energy balance is
     looser than ``POLISH_ENERGY`` are polished by a fixed-frequency Newton solve; a point
     still looser than ``ENERGY_LIMIT`` ends the path (status ``failed``, not kept).
+    ``stop(X, w) -> bool``, called on every point kept, ends the path there when True
+    (status ``stopped``).
     """
     scale = np.r_[xscale, bounds[1] - bounds[0]]
     solver = Arclength(problem, np.r_[problem.unknowns(X0), w0], scale, lam_bounds=bounds,
@@ -76,6 +78,8 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
                    err, problem.nl.last_unclosed)        # of the energy balance's force call at X
         if progress is not None:
             progress(offset + len(pts.w), w / (2 * np.pi))
+        if stop is not None and stop(X, w):
+            return "stopped", "", [f / (2 * np.pi) for f in solver.folds], solver.n_rejected
         if offset + len(pts.w) >= case.analysis.max_points:
             break
     return solver.status, solver.message, [f / (2 * np.pi) for f in solver.folds], solver.n_rejected

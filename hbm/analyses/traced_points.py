@@ -40,17 +40,35 @@ class TracedPoints:
         X : ndarray, shape (n_coef, n)
         w : float
         """
+        return self.chord_through(X, w, rtol) is not None
+
+    def chord_through(self, X: np.ndarray, w: float, rtol: float = ON_PATH) -> int | None:
+        """The first ``i`` such that ``(X, w)`` lies within ``rtol`` of the chord from point
+        ``i`` to point ``i + 1`` (:meth:`passes`), or None."""
         w_all = np.asarray(self.w)
         if w_all.size < 2:
-            return False
+            return None
         a, b = w_all[:-1], w_all[1:]
         for i in np.flatnonzero((np.minimum(a, b) <= w) & (w <= np.maximum(a, b))):
             span = b[i] - a[i]
             s = 0.0 if span == 0 else (w - a[i]) / span
             Xi = (1 - s) * self.X[i] + s * self.X[i + 1]
             if np.linalg.norm(X - Xi) <= rtol * max(np.linalg.norm(Xi), np.linalg.norm(X)):
-                return True
-        return False
+                return int(i)
+        return None
+
+    def part(self, lo: int, hi: int, reverse: bool = False) -> "TracedPoints":
+        """Points ``lo:hi`` as a new path (in reverse order if ``reverse``)."""
+        out = TracedPoints()
+        for name in self.FIELDS:
+            got = getattr(self, name)[lo:hi]
+            setattr(out, name, got[::-1] if reverse else list(got))
+        return out
+
+    def __add__(self, other: "TracedPoints") -> "TracedPoints":
+        out = self.part(0, len(self.w))
+        out.extend(other)
+        return out
 
     def insert(self, at: int, segments, k: int, other: "TracedPoints", lo: int, hi: int) -> int:
         """Insert ``other``'s points ``lo:hi`` before point ``at``, which lies in segment ``k`` of

@@ -74,7 +74,14 @@ def _print_notes(st) -> None:
         joined = sum(g["joined"] for g in b)
         print(f"  note: {len(b)} stop(s) of the continuation marched across at fixed frequencies "
               f"({sum(g['points'] for g in b)} points): {joined} joined the path again"
-              + ("" if joined == len(b) else f", {len(b) - joined} narrowed (the gaps above)"))
+              + ("" if joined == len(b) else f", {len(b) - joined} narrowed"))
+    if st.get("overhangs"):
+        o = st["overhangs"]
+        joined, folded = sum(g["joined"] for g in o), sum(g["sides_folded"] > 0 and not g["joined"] for g in o)
+        print(f"  note: {len(o)} junction(s) of traced segments traced on from both sides "
+              f"({sum(g['points'] for g in o)} points): {joined} joined, {folded} traced round a fold")
+    if st.get("middle_gap_note"):
+        print(f"  note: {st['middle_gap_note']}")
     for key in ("aft_retry", "harmonics_retry"):
         if st.get(key):
             print(f"  note: {st[key]['note']}")

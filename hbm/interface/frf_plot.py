@@ -24,10 +24,10 @@ JUMP_COLOURS = {"up": "tab:red", "down": "tab:blue"}
 
 
 def gap_starts(settings: dict) -> list:
-    """Path indices where a segment restarted past an untraced stretch begins (the drawn
-    curve breaks there): the segment starts of ``settings`` when it records ``gaps``."""
-    if not settings.get("gaps"):
-        return []
+    """Path indices where a segment begins that does not continue the one before (the drawn
+    curve breaks there): every segment start of ``settings`` but the first.  Segments the
+    marches or the traces across a junction joined are one segment; the others meet across a
+    gap, a jump or a middle branch left untraced, which a drawn chord would misstate."""
     return [int(seg[0]) for seg in settings.get("segments", [])[1:]]
 
 

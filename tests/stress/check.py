@@ -87,18 +87,21 @@ def assess(data: dict, **frf_kwargs) -> dict:
     -------
     dict
         ``name``, ``verdict`` (``converged`` / ``gaps`` (finished past stated stops) / ``failed`` / ``bad``), ``detail`` (one line),
-        ``points``, ``max_energy_error``, ``seconds``, ``stuck_checked`` (bool).
+        ``points``, ``max_energy_error``, ``seconds``, ``stuck_checked`` (bool), ``middle_gaps``
+        (stretches of a middle branch between two folds left untraced while every frequency
+        of the window lies on a traced branch: :mod:`hbm.analyses.overhang`).
     """
     case = case_from_dict(data)
     rec = {"name": data["name"], "points": 0, "max_energy_error": float("nan"), "seconds": 0.0,
-           "stuck_checked": False}
+           "stuck_checked": False, "middle_gaps": 0}
     try:
         res = frf(case, **frf_kwargs)
     except Exception as exc:  # noqa: BLE001 - an exception instead of a result is itself a finding
         return {**rec, "verdict": "bad", "detail": f"raised {type(exc).__name__}: {exc}"}
     n = res.freq_hz.size
     rec.update(points=int(n), seconds=float(res.solve_seconds),
-               max_energy_error=float(res.energy_error.max()) if n else float("nan"))
+               max_energy_error=float(res.energy_error.max()) if n else float("nan"),
+               middle_gaps=len(res.settings.get("middle_gaps", ())))
     problems = []
     if not np.all(np.isfinite(res.X)) or not all(np.all(np.isfinite(o.h1)) and np.all(np.isfinite(o.max))
                                                  for o in res.outputs.values()):

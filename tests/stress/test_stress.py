@@ -93,6 +93,7 @@ def table(results) -> str:
         lines.append(f"{family}: {len(rows)} cases, {tot['converged']} converged, {tot['gaps']} finished past "
                      f"stated stops, {tot['failed']} failed (stated), "
                      f"{tot['bad']} bad; stuck limit checked on {sum(r['stuck_checked'] for _, r in rows)}; "
+                     f"a middle branch partly untraced in {sum(r['middle_gaps'] > 0 for _, r in rows)}; "
                      f"max energy error {max((r['max_energy_error'] for _, r in rows if r['points']), default=0):.1e}")
         for key in rows[0][0]:
             by = defaultdict(Counter)

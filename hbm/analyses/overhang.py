@@ -1,0 +1,213 @@
+r"""Branches that overhang a jump: arclength traces from both sides of where two traced
+segments meet without being one solution.
+
+Where the path stops and is restarted further on, and the marches at fixed frequency
+(:mod:`hbm.analyses.gap_bridge`) narrow the gap to little or nothing without joining its
+sides, the two segments usually meet across a fold's jump: below it the path is on one
+branch, above it on another.  A march cannot turn a fold, so the branch that overhangs the
+jump is missing, and no gap says so when the sides meet at one frequency.  On a separating
+contact's softening resonance (the stress matrix's friction3d ``R = 100``, ``kt / k = 1e4``,
+``H = 15``) that was the whole upper branch from 0.2093 Hz down to its fold at 0.2014 Hz,
+with the peak (17.4 against the 11.1 drawn at the jump), stable and confirmed by shooting in
+the time domain.
+
+At every such junction the pseudo-arclength continuation is run on from each side, away
+from the junction (the last point below it upwards, the first point above it downwards),
+from where the marches had passed the spot the first trace stopped at:
+
+* a trace that arrives on the other side's path (within ``MEET`` of one of its chords,
+  :meth:`hbm.analyses.traced_points.TracedPoints.chord_through`, travelling the way the
+  other side's points continue it) joins the two segments;
+* a trace that turns at least one fold keeps its points (it may stop on the middle branch,
+  where the unknowns a stuck contact leaves nearly free make Newton stall): the overhanging
+  branch is traced round its fold;
+* a trace that turns no fold within its budget (``MAX_POINTS``, and all traces together no
+  more points than the path has) runs beside the other side's path on a distinct solution
+  (a contact's slider offset that the sampled re-closure sets differently): it keeps only
+  its points short of the other side's end, which narrow a gap.
+
+When both sides are traced round a fold and do not join, every frequency of the window lies
+on a traced branch and only a stretch of the middle branch between the folds is missing:
+it is stated as such (``settings["middle_gaps"]``, a note), not as a gap of the window.  A
+stated gap with a fold on one side only stays a gap, its reason extended.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from hbm.analyses.gaps import jump, state_gaps
+from hbm.analyses.trace import _trace
+from hbm.analyses.traced_points import TracedPoints
+
+MEET = 1e-4         # a trace within this (relative) of the other side's chord has arrived on it
+MAX_POINTS = 300    # points of one trace: at most this many, and at most as many as the path has
+MIN_POINTS = 50     # ... unless it has fewer than this
+BACK = 3            # a trace that neither joins nor folds is tried again this many points back
+
+
+class _Watch:
+    """The stop test of one trace (module doc): ``(X, w) -> bool``; afterwards ``chord``
+    (index into ``target`` of the chord arrived on, or None), ``folds`` (turns seen) and
+    ``short`` (points after the start before the first one beyond ``w_other`` in
+    ``direction``).  ``along = 1``: the trace must arrive travelling the way ``target``'s
+    points run (they continue it), ``-1``: against it (it is spliced in reversed)."""
+
+    def __init__(self, target, w_other: float, direction: int, budget: int, along: int):
+        self.target, self.w_other, self.direction, self.budget = target, w_other, direction, budget
+        self.along, self.chord, self.folds, self.seen, self.short = along, None, 0, 0, None
+        self.last, self.way = None, direction
+
+    def __call__(self, X, w) -> bool:
+        self.seen += 1
+        if self.last is not None and w != self.last:
+            way = 1 if w > self.last else -1
+            self.folds += way != self.way
+            self.way = way
+        self.last = w
+        if self.seen == 1:
+            return False                         # the start, on its own side
+        if self.short is None and (w - self.w_other) * self.direction > 0:
+            self.short = self.seen - 2
+        i = self.target.chord_through(X, w, MEET)
+        if i is not None and (self.target.w[i + 1] - self.target.w[i]) * self.way * self.along > 0:
+            self.chord = i
+            return True
+        return self.seen > self.budget
+
+
+def _run(ctx, X, w, direction, target, w_other, along):
+    """One trace from ``(X, w)`` (:class:`_Watch`): ``(points kept, watch)``: all points
+    after the start when it joins ``target`` or turns a fold, else those short of
+    ``w_other`` (they narrow the gap)."""
+    problem, case, window, xscale, r_scale, opts, lam_step, n_budget = ctx
+    watch = _Watch(target, w_other, direction, n_budget, along)
+    got = TracedPoints()
+    watch.folds_hz = _trace(problem, case, got, X, 0, w, window, direction, xscale, r_scale, opts, None,
+                            lam_step=lam_step, stop=watch)[2]
+    n = len(got.w)
+    if watch.chord is None and not watch.folds and watch.short is not None:
+        n = 1 + watch.short
+    return got.part(1, n), watch
+
+
+def _side(ctx, seg, up: bool, target, along):
+    """The trace away from one end of ``seg`` (its last point ``up``, else its first):
+    ``(seg', points, watch, spent)``.  When it neither joins nor folds, once more from
+    ``BACK`` points before that end (``seg'`` then ends or starts there): the arclength's start
+    at a point on a fold's very turn can fail where one a few steps before goes round it."""
+    w_other = target.w[0] if up else target.w[-1]
+    i = -1 if up else 0
+    got, watch = _run(ctx, seg.X[i], seg.w[i], 1 if up else -1, target, w_other, along)
+    spent = watch.seen
+    if watch.chord is None and not watch.folds and len(seg.w) > 2 * BACK:
+        base = seg.part(0, len(seg.w) - BACK) if up else seg.part(BACK, len(seg.w))
+        got2, watch2 = _run(ctx, base.X[i], base.w[i], 1 if up else -1, target, w_other, along)
+        spent += watch2.seen
+        if watch2.chord is not None or watch2.folds:
+            return base, got2, watch2, spent
+    return seg, got, watch, spent
+
+
+def _overhang(ctx, low, high):
+    """Traces across one gap between the segments ``low`` and ``high`` (TracedPoints, path
+    order): ``(joined, low', high', watches, spent)`` with ``low'`` the lower segment
+    extended (the whole path when joined, ``high'`` then None), the :class:`_Watch` of each
+    side's trace kept and the points all traces solved."""
+    low, up, wa, spent = _side(ctx, low, True, high, 1)
+    if wa.chord is not None:
+        return True, low + up + high.part(wa.chord + 1, len(high.w)), None, [wa], spent
+    lower = low + up
+    high, down, wb, spent_b = _side(ctx, high, False, lower, -1)
+    spent += spent_b
+    if wb.chord is not None:
+        path = lower.part(0, wb.chord + 1) + down.part(0, len(down.w), reverse=True) + high
+        return True, path, None, [wa, wb], spent
+    return False, lower, down.part(0, len(down.w), reverse=True) + high, [wa, wb], spent
+
+
+def trace_overhangs(problem, case, pts, segments, settings, window, xscale, r_scale, opts, lam_step) -> list:
+    """Trace from both sides of every junction of two segments that are not one solution
+    (module doc), a stated gap (``settings["gaps"]``) or not; ``pts`` and ``segments`` are
+    rebuilt in place, the gaps stated again, a stretch of a middle branch in
+    ``settings["middle_gaps"]`` with ``settings["middle_gap_note"]``, and each attempt in
+    ``settings["overhangs"]``.  Returns the folds turned (Hz)."""
+    segs = [pts.part(a, b) for a, b in segments]
+    gaps = list(settings.get("gaps") or [])
+    folds_hz, middle, record = [], [], []
+    budget = [max(len(pts.w), MIN_POINTS)]      # points of all traces together
+    for k in range(len(segs) - 2, -1, -1):      # the top first: lower indices stay
+        low, high = segs[k], segs[k + 1]
+        n_have = sum(len(s.w) for s in segs)
+        if _rel(low.X[-1], high.X[0]) <= MEET or n_have >= case.analysis.max_points or budget[0] <= 0:
+            continue
+        gap = next((g for g in gaps if np.isclose(g["from_hz"], low.w[-1] / (2 * np.pi), rtol=1e-12, atol=0)), None)
+        ctx = (problem, case, window, xscale, r_scale, opts, lam_step,
+               min(MAX_POINTS, budget[0], case.analysis.max_points - n_have))
+        ends = (low.Y[-1], high.Y[0])          # where the traces start
+        joined, low, high, watches, spent = _overhang(ctx, low, high)
+        budget[0] -= spent
+        sides = [w.folds > 0 for w in watches]
+        folds_hz += [f for w in watches for f in w.folds_hz]
+        added = sum(len(s.w) for s in ([low] if joined else [low, high])) - len(segs[k].w) - len(segs[k + 1].w)
+        segs[k:k + 2] = [low] if joined else [low, high]
+        record.append({"at_hz": segs[k].w[-1] / (2 * np.pi) if joined else low.w[-1] / (2 * np.pi),
+                       "gap": gap is not None, "joined": joined, "sides_folded": sum(sides), "points": added})
+        if joined or gap is None and not all(sides):
+            if gap is not None:
+                gaps.remove(gap)
+            continue
+        if all(sides):
+            ends = sorted((low.w[-1] / (2 * np.pi), high.w[0] / (2 * np.pi)))
+            middle.append({"from_hz": ends[0], "to_hz": ends[1],
+                           "reason": gap["reason"] if gap else "the two traces stopped on it"})
+            if gap is not None:
+                gaps.remove(gap)
+        else:
+            gaps[gaps.index(gap)] = _narrowed(problem.basis, gap, low, high, ends, *sides)
+    _rebuild(pts, segs)
+    segments[:] = _ranges(segs)
+    if record:
+        settings["overhangs"] = record[::-1]
+    settings.pop("gaps", None)
+    settings.pop("gap_warning", None)
+    state_gaps(settings, sorted(gaps, key=lambda g: g["from_hz"]))
+    if middle:
+        settings["middle_gaps"] = sorted(middle, key=lambda g: g["from_hz"])
+        where = ", ".join(f"{g['from_hz']:.6g}..{g['to_hz']:.6g} Hz" for g in settings["middle_gaps"])
+        settings["middle_gap_note"] = (
+            f"the branches on both sides of a jump were traced round their folds, so every frequency of the "
+            f"window lies on a traced branch; the middle branch between the folds is not traced over {where} "
+            f"(where the first trace stopped: {middle[0]['reason']})")
+    return folds_hz
+
+
+def _rel(a, b) -> float:
+    """Relative distance of two coefficient arrays."""
+    return float(np.linalg.norm(a - b) / max(np.linalg.norm(a), np.linalg.norm(b), 1e-300))
+
+
+def _narrowed(basis, gap: dict, low, high, ends, fold_low: bool, fold_high: bool) -> dict:
+    """``gap`` between the segments ``low`` and ``high`` after the traces: the ends that moved
+    towards each other (a side traced round a fold keeps its end ``ends[0]`` or ``ends[1]``,
+    outputs (n_coef, n_out): its branch went on past the other side's), the change across it
+    measured again, and the reason extended."""
+    a = gap["from_hz"] if fold_low else low.w[-1] / (2 * np.pi)
+    b = gap["to_hz"] if fold_high else high.w[0] / (2 * np.pi)
+    out = {**gap, "from_hz": a, "to_hz": b}
+    if a != gap["from_hz"] or b != gap["to_hz"]:
+        out.update(jump(basis, ends[0] if fold_low else low.Y[-1], ends[1] if fold_high else high.Y[0]))
+    if fold_low or fold_high:
+        out["reason"] += "; the branch on one side of it was traced round its fold, the other side's not"
+    return out
+
+
+def _ranges(segs) -> list:
+    """``[start, end)`` index ranges of consecutive segments."""
+    ends = np.cumsum([len(s.w) for s in segs]).tolist()
+    return [[e - len(s.w), e] for s, e in zip(segs, ends)]
+
+
+def _rebuild(pts, segs) -> None:
+    """``pts`` made the concatenation of ``segs``, in place."""
+    for name in pts.FIELDS:
+        getattr(pts, name)[:] = [v for s in segs for v in getattr(s, name)]
