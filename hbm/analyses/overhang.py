@@ -7,54 +7,66 @@ sides, the two segments usually meet across a fold's jump: below it the path is 
 branch, above it on another.  A march cannot turn a fold, so the branch that overhangs the
 jump is missing, and no gap says so when the sides meet at one frequency.  On a separating
 contact's softening resonance (the stress matrix's friction3d ``R = 100``, ``kt / k = 1e4``,
-``H = 15``) that was the whole upper branch from 0.2093 Hz down to its fold at 0.2014 Hz,
-with the peak (17.4 against the 11.1 drawn at the jump), stable and confirmed by shooting in
-the time domain.
+``H = 15``, 0.15-0.3 Hz) that was the whole upper branch below the jump at 0.2093 Hz, with the
+peak: 41.2 at 0.1915 Hz, drawn as 11.1 at the jump.
 
 At every such junction the pseudo-arclength continuation is run on from each side, away
-from the junction (the last point below it upwards, the first point above it downwards),
-from where the marches had passed the spot the first trace stopped at:
+from the junction (the last point below it upwards, the first point above it downwards):
 
 * a trace that arrives on the other side's path (within ``MEET`` of one of its chords,
   :meth:`hbm.analyses.traced_points.TracedPoints.chord_through`, travelling the way the
   other side's points continue it) joins the two segments;
-* a trace that turns at least one fold keeps its points (it may stop on the middle branch,
-  where the unknowns a stuck contact leaves nearly free make Newton stall): the overhanging
-  branch is traced round its fold;
+* a trace that turns a fold keeps its points: the overhanging branch is traced round its
+  fold (it may then stop on the middle branch, where the unknowns a stuck contact leaves
+  nearly free make Newton stall).  A turn counts as a fold only when the trace's last point
+  lies on another branch than the one it came along and Newton at a fixed frequency just
+  past the turn finds no solution near it (:func:`_beyond`);
+* a trace that creeps to a stop in ever shorter steps on a branch that goes on (that
+  fixed-frequency solve lands next to it: on the separating contact, where the tangential
+  slider's offset is nearly free) hops: the branch is marched at fixed frequencies from the
+  solution past the stop until it nears its fold, and traced on from there (:func:`_hop`);
 * a trace that turns no fold within its budget (``MAX_POINTS``, and all traces together no
-  more points than the path has) runs beside the other side's path on a distinct solution
-  (a contact's slider offset that the sampled re-closure sets differently): it keeps only
-  its points short of the other side's end, which narrow a gap.
+  more points than the path has) runs beside the other side's path on a distinct solution:
+  it keeps only its points short of the other side's end, which narrow a gap.
 
-When both sides are traced round a fold and do not join, every frequency of the window lies
-on a traced branch and only a stretch of the middle branch between the folds is missing:
-it is stated as such (``settings["middle_gaps"]``, a note), not as a gap of the window.  A
-stated gap with a fold on one side only stays a gap, its reason extended.
+When both sides turn a fold and do not join, every frequency of the window lies on a traced
+branch and only a stretch of the middle branch between the folds is missing: it is stated as
+such (``settings["middle_gaps"]``, a note), not as a gap of the window.  A stated gap that
+is not joined stays one; where its two sides now overlap in frequency its reason says that
+one branch goes on untraced past its end (a peak there may be missing).  A junction that no
+gap stated and the traces do not resolve stays as it was (``settings["overhangs"]`` records
+it): on stiff stuck contacts the trace from one side often runs beside the other side's path
+on the same motion with another slider offset, which is no missing branch.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from hbm.analyses.gap_bridge import _Marcher, march
+from hbm.analyses.problem_setup import recover_outputs
 from hbm.analyses.gaps import jump, state_gaps
 from hbm.analyses.trace import _trace
 from hbm.analyses.traced_points import TracedPoints
 
 MEET = 1e-4         # a trace within this (relative) of the other side's chord has arrived on it
-MAX_POINTS = 300    # points of one trace: at most this many, and at most as many as the path has
+MAX_POINTS = 600    # points of one trace: at most this many, and all together no more than the path has
 MIN_POINTS = 50     # ... unless it has fewer than this
 BACK = 3            # a trace that neither joins nor folds is tried again this many points back
+PROBE = 1e-4        # a fold is checked by a solve this share of its frequency past it ...
+GOES_ON = 0.1       # ... which must not land within this (relative) of the fold's point (a march's largest step)
+ON_BRANCH = 1e-3    # a trace whose last point is this close to its path before the turn came back
+HOPS = 50           # a trace that creeps to a stop is traced on past it this many times at most
 
 
 class _Watch:
     """The stop test of one trace (module doc): ``(X, w) -> bool``; afterwards ``chord``
-    (index into ``target`` of the chord arrived on, or None), ``folds`` (turns seen) and
-    ``short`` (points after the start before the first one beyond ``w_other`` in
-    ``direction``).  ``along = 1``: the trace must arrive travelling the way ``target``'s
+    (index into ``target`` of the chord arrived on, or None) and ``folds`` (turns seen).
+    ``along = 1``: the trace must arrive travelling the way ``target``'s
     points run (they continue it), ``-1``: against it (it is spliced in reversed)."""
 
-    def __init__(self, target, w_other: float, direction: int, budget: int, along: int):
-        self.target, self.w_other, self.direction, self.budget = target, w_other, direction, budget
-        self.along, self.chord, self.folds, self.seen, self.short = along, None, 0, 0, None
+    def __init__(self, target, direction: int, budget: int, along: int):
+        self.target, self.direction, self.budget = target, direction, budget
+        self.along, self.chord, self.folds, self.seen = along, None, 0, 0
         self.last, self.way = None, direction
 
     def __call__(self, X, w) -> bool:
@@ -66,8 +78,6 @@ class _Watch:
         self.last = w
         if self.seen == 1:
             return False                         # the start, on its own side
-        if self.short is None and (w - self.w_other) * self.direction > 0:
-            self.short = self.seen - 2
         i = self.target.chord_through(X, w, MEET)
         if i is not None and (self.target.w[i + 1] - self.target.w[i]) * self.way * self.along > 0:
             self.chord = i
@@ -78,28 +88,93 @@ class _Watch:
 def _run(ctx, X, w, direction, target, w_other, along):
     """One trace from ``(X, w)`` (:class:`_Watch`): ``(points kept, watch)``: all points
     after the start when it joins ``target`` or turns a fold, else those short of
-    ``w_other`` (they narrow the gap)."""
+    ``w_other`` (they narrow the gap).  Where the trace creeps to a stop on a branch that goes
+    on (:func:`_beyond`), it hops: its points up to the farthest one are kept, the branch is
+    marched on from the solution past it (:func:`_hop`) and traced on from the march's end,
+    ``HOPS`` times at most."""
     problem, case, window, xscale, r_scale, opts, lam_step, n_budget = ctx
-    watch = _Watch(target, w_other, direction, n_budget, along)
-    got = TracedPoints()
-    watch.folds_hz = _trace(problem, case, got, X, 0, w, window, direction, xscale, r_scale, opts, None,
-                            lam_step=lam_step, stop=watch)[2]
-    n = len(got.w)
-    if watch.chord is None and not watch.folds and watch.short is not None:
-        n = 1 + watch.short
-    return got.part(1, n), watch
+    watch = _Watch(target, direction, n_budget, along)
+    kept, watch.folds_hz, skip = TracedPoints(), [], 1     # the first trace's start is not new
+    for _ in range(HOPS + 1):
+        got = TracedPoints()
+        watch.folds_hz += _trace(problem, case, got, X, 0, w, window, direction, xscale, r_scale, opts, None,
+                                 lam_step=lam_step, stop=watch)[2]
+        if watch.chord is not None or len(got.w) < 2:
+            break
+        turned, past = _beyond(ctx, got, direction)
+        if turned or past is None or watch.seen > watch.budget:
+            watch.folds = watch.folds if turned else 0
+            break
+        kept = kept + got.part(skip, int(np.argmax(direction * np.asarray(got.w))) + 1)
+        watch.folds, watch.folds_hz, watch.last, watch.way = 0, [], None, direction
+        hop = _hop(ctx, watch, past, direction)
+        kept, got, skip = kept + hop, TracedPoints(), 1   # the next trace starts on the hop's end
+        if watch.chord is not None:
+            break
+        X, w = hop.X[-1], hop.w[-1]
+    kept = kept + got.part(skip, len(got.w))
+    n = len(kept.w)
+    if watch.chord is None and not watch.folds:
+        beyond = np.flatnonzero((np.asarray(kept.w) - w_other) * direction > 0)
+        n = int(beyond[0]) if beyond.size else n
+    return kept.part(0, n), watch
+
+
+def _hop(ctx, watch, past, direction) -> TracedPoints:
+    """Past a spot where a trace crept to a stop: the solution ``past`` there (from
+    :func:`_beyond`) and a march at fixed frequencies on from it
+    (:func:`hbm.analyses.gap_bridge.march`, towards the window's end in ``direction``, within
+    the trace's budget), which stops where the branch nears its fold or jumps; every point is
+    shown to ``watch`` (a join ends the hop there)."""
+    problem, case, window, xscale, r_scale = ctx[:5]
+    m = _Marcher(problem, xscale, r_scale, budget=max(watch.budget - watch.seen, 1))
+    marched, _ = march(m, past[0], window[1] if direction > 0 else window[0])
+    out = TracedPoints()
+    for v, its, err, unclosed in [past] + marched:
+        X, w = problem.expand(v[:-1]), float(v[-1])
+        out.append(X, w, recover_outputs(problem, case, X, w), its, err, unclosed)
+        if watch(X, w):
+            break
+    return out
+
+
+def _beyond(ctx, got, direction):
+    """Whether the trace ``got`` (its start first) turned at a fold at the farthest frequency
+    it reached in ``direction``, and the solution past that point where its branch goes on:
+    ``(turned, past)``, ``past`` (``([u, w], iterations, energy_error, unclosed)``,
+    :meth:`_Marcher.solve`) or None.  A fold: the trace's last point lies on another branch
+    than the one it came along (not within ``ON_BRANCH`` of its path up to the farthest
+    point) and Newton at a fixed frequency ``PROBE`` past the farthest point finds no solution
+    near it (none within ``GOES_ON``).  A trace that creeps in ever shorter steps and zigzags
+    where Newton is ill-conditioned (a stuck contact's nearly free slider offset) turns back
+    in frequency too, but along its own path, and past that spot the solve lands next to it.
+    A trace that stops at the farthest point is no evidence of a fold: in a field of thin
+    facets of a poorly truncated solution Newton fails there as well."""
+    problem, case, window, xscale, r_scale = ctx[:5]
+    k = int(np.argmax(direction * np.asarray(got.w)))
+    away = k < len(got.w) - 1 and not got.part(0, k + 1).passes(got.X[-1], got.w[-1], ON_BRANCH)
+    w = got.w[k] * (1 + direction * PROBE)
+    if not window[0] <= w <= window[1]:
+        return away, None
+    m = _Marcher(problem, xscale, r_scale)
+    v = np.r_[problem.unknowns(got.X[k]), got.w[k]]
+    probe = m.solve(np.r_[v[:-1], w])
+    if probe is not None and m.change(probe[0], v) <= GOES_ON:
+        return False, probe
+    return away, None
 
 
 def _side(ctx, seg, up: bool, target, along):
     """The trace away from one end of ``seg`` (its last point ``up``, else its first):
-    ``(seg', points, watch, spent)``.  When it neither joins nor folds, once more from
+    ``(seg', points, watch, spent)``.  When it neither joins nor folds and keeps fewer than
+    ``BACK`` points, once more from
     ``BACK`` points before that end (``seg'`` then ends or starts there): the arclength's start
     at a point on a fold's very turn can fail where one a few steps before goes round it."""
     w_other = target.w[0] if up else target.w[-1]
     i = -1 if up else 0
     got, watch = _run(ctx, seg.X[i], seg.w[i], 1 if up else -1, target, w_other, along)
     spent = watch.seen
-    if watch.chord is None and not watch.folds and len(seg.w) > 2 * BACK:
+    if watch.chord is None and not watch.folds and len(got.w) < BACK and len(seg.w) > 2 * BACK:
         base = seg.part(0, len(seg.w) - BACK) if up else seg.part(BACK, len(seg.w))
         got2, watch2 = _run(ctx, base.X[i], base.w[i], 1 if up else -1, target, w_other, along)
         spent += watch2.seen
@@ -152,17 +227,14 @@ def trace_overhangs(problem, case, pts, segments, settings, window, xscale, r_sc
         segs[k:k + 2] = [low] if joined else [low, high]
         record.append({"at_hz": segs[k].w[-1] / (2 * np.pi) if joined else low.w[-1] / (2 * np.pi),
                        "gap": gap is not None, "joined": joined, "sides_folded": sum(sides), "points": added})
-        if joined or gap is None and not all(sides):
+        if joined or all(sides):
             if gap is not None:
                 gaps.remove(gap)
-            continue
-        if all(sides):
-            ends = sorted((low.w[-1] / (2 * np.pi), high.w[0] / (2 * np.pi)))
-            middle.append({"from_hz": ends[0], "to_hz": ends[1],
-                           "reason": gap["reason"] if gap else "the two traces stopped on it"})
-            if gap is not None:
-                gaps.remove(gap)
-        else:
+            if not joined:
+                fs = sorted((low.w[-1] / (2 * np.pi), high.w[0] / (2 * np.pi)))
+                middle.append({"from_hz": fs[0], "to_hz": fs[1],
+                               "reason": gap["reason"] if gap else "the two traces stopped on it"})
+        elif gap is not None:
             gaps[gaps.index(gap)] = _narrowed(problem.basis, gap, low, high, ends, *sides)
     _rebuild(pts, segs)
     segments[:] = _ranges(segs)
@@ -193,11 +265,14 @@ def _narrowed(basis, gap: dict, low, high, ends, fold_low: bool, fold_high: bool
     measured again, and the reason extended."""
     a = gap["from_hz"] if fold_low else low.w[-1] / (2 * np.pi)
     b = gap["to_hz"] if fold_high else high.w[0] / (2 * np.pi)
-    out = {**gap, "from_hz": a, "to_hz": b}
-    if a != gap["from_hz"] or b != gap["to_hz"]:
-        out.update(jump(basis, ends[0] if fold_low else low.Y[-1], ends[1] if fold_high else high.Y[0]))
+    out = {**gap, "from_hz": min(a, b), "to_hz": max(a, b)}
+    out.update(jump(basis, ends[0] if fold_low else low.Y[-1], ends[1] if fold_high else high.Y[0]))
     if fold_low or fold_high:
         out["reason"] += "; the branch on one side of it was traced round its fold, the other side's not"
+    if b <= a:
+        out["reason"] += (f"; the branches on its two sides overlap in frequency and one of them goes on "
+                          f"untraced past its end at {(b if not fold_high else a):.6g} Hz (a peak there "
+                          f"may be missing)")
     return out
 
 
