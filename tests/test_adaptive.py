@@ -112,6 +112,21 @@ def test_most_points_over_the_tolerance_retrace_the_path():
     assert a["met"] and np.nanmax(res.outputs[list(res.outputs)[0]].err) <= 1e-4
 
 
+def test_raising_stops_at_the_time_budget_and_says_so(monkeypatch):
+    """The SDOF rig at 1e-4 traces its path again at H = 11 (above); with no time to spare the
+    first trace is kept, no point is refined, the tolerance is reported not met and the note
+    says why (a stiff stuck contact's output whose estimate never falls once kept the default
+    ``hbm frf`` raising harmonics for over 20 minutes)."""
+    from hbm.analyses import adaptive
+    monkeypatch.setattr(adaptive, "ADAPT_SECONDS", 0.0)
+    res = frf_to_tolerance(hbm.load_case("rigs/sdof_jenkins.toml"), 1e-4, stability=False)
+    a = res.settings["adaptive"]
+    assert [t["H"] for t in a["tried"]] == [7] and not a["met"]
+    assert not a["points"]["levels"] or a["points"]["levels"][0]["points"] == 0
+    assert "not traced again at H = 11" in a["budget_note"] and "refinement stopped" in a["budget_note"]
+    assert a["points"]["left_above"] == int(np.sum(res.outputs[list(res.outputs)[0]].err > 1e-4))
+
+
 def test_harmonics_that_carry_something_are_kept():
     """A contact that separates (normal preload, a gap opening once per period) has even
     harmonics: they stay in the richer sets."""

@@ -61,8 +61,8 @@ HOPS = 50           # a trace that creeps to a stop is traced on past it this ma
 class _Watch:
     """The stop test of one trace (module doc): ``(X, w) -> bool``; afterwards ``chord``
     (index into ``target`` of the chord arrived on, or None) and ``folds`` (turns seen).
-    ``along = 1``: the trace must arrive travelling the way ``target``'s
-    points run (they continue it), ``-1``: against it (it is spliced in reversed)."""
+    ``along = 1``: the trace must arrive travelling the way ``target``'s points run (they
+    continue it), ``-1``: against it (it is spliced in reversed)."""
 
     def __init__(self, target, direction: int, budget: int, along: int):
         self.target, self.direction, self.budget = target, direction, budget
@@ -167,9 +167,9 @@ def _beyond(ctx, got, direction):
 def _side(ctx, seg, up: bool, target, along):
     """The trace away from one end of ``seg`` (its last point ``up``, else its first):
     ``(seg', points, watch, spent)``.  When it neither joins nor folds and keeps fewer than
-    ``BACK`` points, once more from
-    ``BACK`` points before that end (``seg'`` then ends or starts there): the arclength's start
-    at a point on a fold's very turn can fail where one a few steps before goes round it."""
+    ``BACK`` points, once more from ``BACK`` points before that end (``seg'`` then ends or
+    starts there): the arclength's start at a point on a fold's very turn can fail where one a
+    few steps before goes round it."""
     w_other = target.w[0] if up else target.w[-1]
     i = -1 if up else 0
     got, watch = _run(ctx, seg.X[i], seg.w[i], 1 if up else -1, target, w_other, along)

@@ -142,17 +142,19 @@ def _point_record(case, lv: _Level, X, w, stability_options, with_stability: boo
 
 
 def refine_points(case, res, tol: float, window_hz, transform="auto", stability_options=None, start=None,
-                  progress=None):
+                  progress=None, deadline=None):
     """``res`` with every point whose estimated error exceeds ``tol`` solved again on richer
     harmonics until within it (module doc).  Returns ``(result, info)``; ``info`` lists the
     levels (highest harmonic, samples, points solved there), the points left above ``tol``, the
     failed solves and the time taken.  ``start``: the harmonics whose richer sets are tried
     (default: the result's; :func:`hbm.analyses.adaptive.carried_harmonics` leaves out those that
     carry nothing).  ``progress.refining(done, total, H)`` is called per point when ``progress``
-    has it (:class:`hbm.interface.progress.FRFProgress`)."""
+    has it (:class:`hbm.interface.progress.FRFProgress`).  Past ``deadline`` (a
+    ``time.perf_counter()`` value) no level and no point is started: ``info["stopped_hz"]`` is
+    then ``[frequency of the first point not solved, H]``, else None."""
     t0 = time.perf_counter()
     todo = [int(i) for i in np.flatnonzero(over_tolerance(res, tol))]
-    info = {"levels": [], "left_above": 0, "failed": 0, "failed_hz": []}
+    info = {"levels": [], "left_above": 0, "failed": 0, "failed_hz": [], "stopped_hz": None}
     segments = res.settings.get("segments") or [(0, res.freq_hz.size)]
     current = {i: (res.X[i], 2 * np.pi * res.freq_hz[i], res.basis) for i in todo}
     records, h, stuck_above = {}, list(start if start is not None else res.basis.harmonics), []
@@ -167,6 +169,10 @@ def refine_points(case, res, tol: float, window_hz, transform="auto", stability_
         left = []
         tell = getattr(progress, "refining", None)
         for done, i in enumerate(todo):
+            if deadline is not None and time.perf_counter() > deadline:
+                info["stopped_hz"] = [round(float(res.freq_hz[i]), 6), int(max(h))]
+                left += todo[done:]
+                break
             if tell is not None:
                 tell(done, len(todo), int(max(h)))
             X0, w0, b0 = current[i]
@@ -185,6 +191,8 @@ def refine_points(case, res, tol: float, window_hz, transform="auto", stability_
             if np.nanmax(records[i]["err"], initial=0.0) > tol:
                 left.append(i)
         todo = left
+        if info["stopped_hz"] is not None:
+            break
     info["left_above"] = len(todo) + len(stuck_above)
     out = _merged(res, records) if records else res
     return out, dict(info, seconds=round(time.perf_counter() - t0, 4))

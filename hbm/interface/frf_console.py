@@ -125,6 +125,8 @@ def _print_adaptive(a: dict, explicit: bool) -> None:
           f"({pts['seconds']:.2f} s)" + ("" if a["met"] else
                                          f": tolerance NOT met (largest estimate {a['max_error']:.1e}, "
                                          f"{pts['left_above']} points above, {pts['failed']} refinements failed)"))
+    if a.get("budget_note"):
+        print(f"  note: {a['budget_note']} (the estimates above are of the harmonics reached)", file=sys.stderr)
     if pts.get("failed_hz"):
         seen = list(dict.fromkeys(f"{f:.6g} Hz (H = {h})" for f, h in pts["failed_hz"]))
         where = ", ".join(seen[:5]) + (f" and {len(seen) - 5} more" if len(seen) > 5 else "")
