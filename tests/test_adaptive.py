@@ -119,6 +119,7 @@ def test_raising_stops_at_the_time_budget_and_says_so(monkeypatch):
     ``hbm frf`` raising harmonics for over 20 minutes)."""
     from hbm.analyses import adaptive
     monkeypatch.setattr(adaptive, "ADAPT_SECONDS", 0.0)
+    monkeypatch.setattr(adaptive, "ADAPT_SHARE", 0.0)
     res = frf_to_tolerance(hbm.load_case("rigs/sdof_jenkins.toml"), 1e-4, stability=False)
     a = res.settings["adaptive"]
     assert [t["H"] for t in a["tried"]] == [7] and not a["met"]

@@ -11,10 +11,11 @@ the richer sets (:func:`carried_harmonics`): they follow the odd pattern, at hal
 ``settings["adaptive"]`` lists every trace (its harmonics, largest estimate, share of points
 above ``tol``, time) and the points refined per harmonic level.
 
-Raising stops at ``ADAPT_SECONDS``: no further trace is started when the time so far and its
-predicted time (:func:`hbm.analyses.harmonics_retry.predicted_seconds`) exceed it, and no
-further refinement level or point once it is spent; ``settings["adaptive"]["budget_note"]``
-says where.  An output whose estimate does not fall with H (a stiff stuck contact's needle
+Raising stops at a budget: the first trace's time plus the larger of ``ADAPT_SECONDS`` and
+``ADAPT_SHARE`` times it.  No further trace is started when the time so far and its predicted
+time (:func:`hbm.analyses.harmonics_retry.predicted_seconds`) exceed it, and no further
+refinement level or point once it is spent; ``settings["adaptive"]["budget_note"]`` says
+where.  An output whose estimate does not fall with H (a stiff stuck contact's needle
 response, far above any affordable harmonics) once made the default ``hbm frf`` climb to
 H = 53 and refine to 63 for over 20 minutes on a two-DOF case.
 """
@@ -27,7 +28,8 @@ import time
 import numpy as np
 
 H_MAX = 63
-ADAPT_SECONDS = 120.0  # harmonics are raised while the time so far and the next step's predicted stay within
+ADAPT_SECONDS = 120.0  # raising harmonics may add this much time to the first trace's ...
+ADAPT_SHARE = 1.0      # ... or this share of the first trace's time, whichever is more
 DEFAULT_TOL = 1e-2    # ``hbm frf`` without --harmonics or --tol: points estimated worse are refined
 WHOLE_SHARE = 0.5     # above this share of points over tol, the whole path is traced again
 
@@ -77,7 +79,7 @@ def frf_to_tolerance(case, tol: float, harmonics=None, **kwargs):
                                        kwargs.get("fmax"), kwargs.get("transform"))
     # the first trace takes the harmonics as given (None: the case's, with the case's samples),
     # the next ones their richer lists
-    h, given, tried, t0, budget_note = list(h), harmonics, [], time.perf_counter(), None
+    h, given, tried, t0, budget_note, deadline = list(h), harmonics, [], time.perf_counter(), None, None
     while True:
         t1 = time.perf_counter()
         res = frf(case, harmonics=given, error_estimate=True, **kwargs)
@@ -85,23 +87,26 @@ def frf_to_tolerance(case, tol: float, harmonics=None, **kwargs):
         share = float(np.mean(over_tolerance(res, tol))) if res.freq_hz.size else 0.0
         tried.append({"H": int(max(h)), "max_error": _worst(res), "share_above": round(share, 4),
                       "seconds": round(time.perf_counter() - t1, 4), "status": res.status})
+        if deadline is None:
+            first = tried[0]["seconds"]
+            deadline = t0 + first + max(ADAPT_SECONDS, ADAPT_SHARE * first)
         if share <= WHOLE_SHARE or max(h) >= H_MAX or not res.ok or not math.isfinite(tried[-1]["max_error"]):
             break
         nxt = next_harmonics(carried_harmonics(res))
-        ahead = time.perf_counter() - t0 + predicted_seconds(tried[-1]["seconds"], h, nxt)
-        if ahead > ADAPT_SECONDS:
+        ahead = time.perf_counter() + predicted_seconds(tried[-1]["seconds"], h, nxt)
+        if ahead > deadline:
             budget_note = (f"the path was not traced again at H = {max(nxt)}: with the time so far that "
-                           f"would take about {ahead:.0f} s, past the {ADAPT_SECONDS:g} s budget")
+                           f"would take about {ahead - t0:.0f} s, past the budget of {deadline - t0:.0f} s")
             break
         h = given = nxt
     start = carried_harmonics(res)
     dropped = [int(x) for x in res.basis.harmonics if x not in start]
     res, refined = refine_points(case, res, tol, (lo, hi), kwargs.get("transform") or "auto",
                                  kwargs.get("stability_options"), start, kwargs.get("progress"),
-                                 deadline=t0 + ADAPT_SECONDS)
+                                 deadline=deadline)
     if refined.get("stopped_hz") is not None:
         budget_note = "; ".join(filter(None, [budget_note, (
-            f"refinement stopped at the {ADAPT_SECONDS:g} s budget at H = {refined['stopped_hz'][1]} "
+            f"refinement stopped at the budget of {deadline - t0:.0f} s at H = {refined['stopped_hz'][1]} "
             f"({refined['left_above']} points left above tol)")]))
     res = _confirmed(case, res, base_harmonics=int(max(h)))
     worst = _worst(res)
