@@ -232,8 +232,7 @@ def trace_overhangs(problem, case, pts, segments, settings, window, xscale, r_sc
                 gaps.remove(gap)
             if not joined:
                 fs = sorted((low.w[-1] / (2 * np.pi), high.w[0] / (2 * np.pi)))
-                middle.append({"from_hz": fs[0], "to_hz": fs[1],
-                               "reason": gap["reason"] if gap else "the two traces stopped on it"})
+                middle.append({"from_hz": fs[0], "to_hz": fs[1], "reason": gap["reason"] if gap else ""})
         elif gap is not None:
             gaps[gaps.index(gap)] = _narrowed(problem.basis, gap, low, high, ends, *sides)
     _rebuild(pts, segs)
@@ -249,7 +248,8 @@ def trace_overhangs(problem, case, pts, segments, settings, window, xscale, r_sc
         settings["middle_gap_note"] = (
             f"the branches on both sides of a jump were traced round their folds, so every frequency of the "
             f"window lies on a traced branch; the middle branch between the folds is not traced over {where} "
-            f"(where the first trace stopped: {middle[0]['reason']})")
+            + (f"(where the first trace stopped: {middle[0]['reason']})" if middle[0]["reason"] else
+               "(the two traces from its ends stopped on it)"))
     return folds_hz
 
 

@@ -127,8 +127,9 @@ def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, option
     pts, segments, (status, message, folds, n_rej), xscale = trace_window(
         problem, case, (w_lo, w_hi), xscale, r_scale, options or ArclengthOptions(), progress, settings)
     bridge_gaps(problem, case, pts, segments, settings, xscale, r_scale, progress)
-    folds = folds + trace_overhangs(problem, case, pts, segments, settings, (w_lo, w_hi), xscale, r_scale,
-                                    options or ArclengthOptions(), _step_limit(problem, case, (w_lo, w_hi)))
+    if len(segments) > 1:
+        folds = folds + trace_overhangs(problem, case, pts, segments, settings, (w_lo, w_hi), xscale, r_scale,
+                                        options or ArclengthOptions(), _step_limit(problem, case, (w_lo, w_hi)))
     if status != "finished" or settings.get("gaps"):
         hint = stiff_contact_hint(case)
         if hint:
