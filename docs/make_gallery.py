@@ -66,6 +66,8 @@ def rig_page(case: pathlib.Path) -> str:
     for key in ("gap_warning", "truncation_warning", "stability_warning", "closure_warning"):
         if st.get(key):
             page += [f"Warning: {st[key]}", ""]
+    if st.get("middle_gap_note"):
+        page += [f"Note: {st['middle_gap_note']}", ""]
     if s["status"] != "finished":
         page += [f"**`hbm frf` stops on this rig with its defaults:** {s['message']}", ""]
     if st.get("time_fill"):
