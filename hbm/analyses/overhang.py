@@ -60,14 +60,20 @@ HOPS = 50           # a trace that creeps to a stop is traced on past it this ma
 
 class _Watch:
     """The stop test of one trace (module doc): ``(X, w) -> bool``; afterwards ``chord``
-    (index into ``target`` of the chord arrived on, or None) and ``folds`` (turns seen).
+    (index into ``target`` of the chord arrived on, or None), ``folds`` (turns seen) and
+    ``folds_hz`` (the folds the traces reported, filled in by :func:`_run`).
     ``along = 1``: the trace must arrive travelling the way ``target``'s points run (they
     continue it), ``-1``: against it (it is spliced in reversed)."""
 
     def __init__(self, target, direction: int, budget: int, along: int):
         self.target, self.direction, self.budget = target, direction, budget
-        self.along, self.chord, self.folds, self.seen = along, None, 0, 0
-        self.last, self.way = None, direction
+        self.along, self.chord, self.seen = along, None, 0
+        self.restart()
+
+    def restart(self) -> None:
+        """Forget the turns seen (``folds``, and ``folds_hz`` the traces reported): the trace
+        goes on past a creep from a point where it heads in ``direction`` again."""
+        self.folds, self.folds_hz, self.last, self.way = 0, [], None, self.direction
 
     def __call__(self, X, w) -> bool:
         self.seen += 1
@@ -94,7 +100,7 @@ def _run(ctx, X, w, direction, target, w_other, along):
     ``HOPS`` times at most."""
     problem, case, window, xscale, r_scale, opts, lam_step, n_budget = ctx
     watch = _Watch(target, direction, n_budget, along)
-    kept, watch.folds_hz, skip = TracedPoints(), [], 1     # the first trace's start is not new
+    kept, skip = TracedPoints(), 1          # the first trace's start is not new
     for _ in range(HOPS + 1):
         got = TracedPoints()
         watch.folds_hz += _trace(problem, case, got, X, 0, w, window, direction, xscale, r_scale, opts, None,
@@ -106,7 +112,7 @@ def _run(ctx, X, w, direction, target, w_other, along):
             watch.folds = watch.folds if turned else 0
             break
         kept = kept + got.part(skip, int(np.argmax(direction * np.asarray(got.w))) + 1)
-        watch.folds, watch.folds_hz, watch.last, watch.way = 0, [], None, direction
+        watch.restart()
         hop = _hop(ctx, watch, past, direction)
         kept, got, skip = kept + hop, TracedPoints(), 1   # the next trace starts on the hop's end
         if watch.chord is not None:
