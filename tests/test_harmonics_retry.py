@@ -96,6 +96,19 @@ def test_a_rung_predicted_past_the_budget_is_named_not_run(monkeypatch):
     assert "--harmonics 8; not tried: about 74 s predicted" in res.settings["harmonics_hint"]
 
 
+def test_the_budget_counts_the_trace_not_the_stability_pass(monkeypatch):
+    """The same run with a stability pass that took 30 s more (``solve_seconds`` 32, trace 2 s)
+    is retried as the run without it: a curve must not depend on --no-stability."""
+    first = _run([1.0, 2.0, 2.5, 4.0], [[0, 2], [2, 4]], [0.01, 0.4, 0.5, 0.01], seconds=32.0)
+    first.settings["trace_seconds"] = 2.0
+    done = _run([1.0, 2.2, 2.3, 4.0], [[0, 4]], [0.01] * 4, H=8)
+    res, calls = _ladder(monkeypatch, first, [done])
+    assert [c[0] for c in calls] == [8] and res is done
+    del first.settings["trace_seconds"]
+    res, calls = _ladder(monkeypatch, first, [done])        # without it the whole 32 s count
+    assert res is first and not calls and "not tried: about 118 s predicted" in res.settings["harmonics_hint"]
+
+
 def test_a_richer_run_that_covers_less_is_not_kept(monkeypatch):
     """The richer run leaves more untraced and stops where its estimate is small: the asked run
     is kept with its gap, and the note says both were tried."""

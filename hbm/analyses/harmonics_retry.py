@@ -23,7 +23,8 @@ the run that covers most of the window is kept, by the rule of the events retry
 tried and kept; every point's harmonics are those of the run kept.  Each rung is a whole
 :func:`hbm.analyses.response.frf` trace (with its events retry); none starts once the runs so
 far with its predicted time (the last run's, scaled by the cube of the unknowns' ratio) would
-take more than ``RETRY_SECONDS``, and a stop that richer harmonics do not remove (a fold
+take more than ``RETRY_SECONDS`` of tracing (:func:`hbm.analyses.aft_retry.trace_seconds`:
+the stability pass is not counted, so runs with and without it retry alike), and a stop that richer harmonics do not remove (a fold
 whose branches the continuation cannot join at any of the sets tried) stays stated.
 Harmonics given as an argument (``--harmonics``, or by :func:`hbm.analyses.adaptive` for its
 richer traces) are kept as asked; the run's ``harmonics_hint`` then names the next set.
@@ -35,7 +36,7 @@ import time
 
 import numpy as np
 
-from hbm.analyses.aft_retry import RETRY_SECONDS, better_run, untraced_hz
+from hbm.analyses.aft_retry import RETRY_SECONDS, better_run, trace_seconds, untraced_hz
 from hbm.balance.fourier import default_samples, min_samples
 
 ERR_STOP = 0.1          # estimated error at a stop's bounding points above which H is blamed
@@ -96,7 +97,7 @@ def _stopped(res) -> bool:
 def _blames_harmonics(res) -> bool:
     """``res`` stopped where its harmonics are inadequate (module doc), and may be repeated."""
     from hbm.analyses.adaptive import H_MAX
-    return (_stopped(res) and res.solve_seconds <= RETRY_SECONDS and int(max(res.basis.harmonics)) < H_MAX
+    return (_stopped(res) and trace_seconds(res) <= RETRY_SECONDS and int(max(res.basis.harmonics)) < H_MAX
             and stop_error(res) > ERR_STOP)
 
 
@@ -106,7 +107,7 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
 
     Up to ``RUNGS`` richer sets are tried, each the next after the last run's, while the last
     run still stops where its estimate blames the harmonics and the runs so far (the first's
-    solve time and each rung's wall time, its events retry included) with the next one's
+    trace time and each rung's, its events retry included) with the next one's
     predicted time (:func:`predicted_seconds`) stay within ``RETRY_SECONDS``.  When even the
     first rung would not, ``settings["harmonics_hint"]`` names it with its predicted time.
 
@@ -128,21 +129,22 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
     if not _blames_harmonics(res):
         return res
     h = next_harmonics(carried_harmonics(res))
-    guess = predicted_seconds(res.solve_seconds, res.basis.harmonics, h)
-    if given is not None or res.solve_seconds + guess > RETRY_SECONDS:
+    guess = predicted_seconds(trace_seconds(res), res.basis.harmonics, h)
+    if given is not None or trace_seconds(res) + guess > RETRY_SECONDS:
         why = ("with H left to the case, hbm frf tries them itself" if given is not None else
                f"not tried: about {guess:.0f} s predicted")
         res.settings["harmonics_hint"] = (
             f"the path stopped where the estimated error of the first harmonics is {stop_error(res):.2g}: richer "
             f"harmonics may pass it (--harmonics {_as_argument(h)}; {why})")
         return res
-    best, last, runs, spent = res, res, [], float(res.solve_seconds)
+    best, last, runs, spent = res, res, [], trace_seconds(res)
     while True:                     # h: the next set, its time within the budget (checked above)
         err = stop_error(last)
         t0 = time.perf_counter()
         last = trace(h, _samples_for(samples, h, case.analysis.samples_factor))
         secs = time.perf_counter() - t0
-        spent += secs
+        work = trace_seconds(last) + last.settings.get("aft_retry", {}).get("other_run_seconds", 0.0)
+        spent += work
         runs.append({"H": int(max(h)), "harmonics": h, "after_stop_error": err, "status": last.status,
                      "untraced_hz": untraced_hz(last), "gaps": len(last.settings.get("gaps", ())),
                      "seconds": secs})
@@ -151,7 +153,7 @@ def retry_with_harmonics(case, res, trace, samples=None, given=None):
         if len(runs) == RUNGS or not _blames_harmonics(last):
             break
         h_last, h = h, next_harmonics(carried_harmonics(last))
-        if spent + predicted_seconds(secs, h_last, h) > RETRY_SECONDS:
+        if spent + predicted_seconds(work, h_last, h) > RETRY_SECONDS:
             break
     H0, Hk = int(max(res.basis.harmonics)), int(max(best.basis.harmonics))
     why = "stopped" if res.status != "finished" else "left gaps"

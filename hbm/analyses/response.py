@@ -135,6 +135,7 @@ def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, option
         if hint:
             settings["contact_hint"] = hint
     _add_points(problem, case, pts, segments, (w_lo, w_hi), xscale, r_scale, settings, progress)
+    settings["trace_seconds"] = time.perf_counter() - t0      # what the retries judge (aft_retry)
     pts_X, pts_w, pts_Y, its, eerr = pts.X, pts.w, pts.Y, pts.its, pts.err
     settings["segments"] = segments
     _closure_warning(settings, pts.unclosed, pts.w)
