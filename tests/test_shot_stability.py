@@ -29,10 +29,10 @@ def test_unstable_multipliers_of_a_shot_orbit_are_reported():
 
 
 def test_the_time_fill_marks_an_unstable_shot_orbit(monkeypatch):
-    import hbm.analyses.time_fill as tf
+    import hbm.analyses.time_points as tp
     import hbm.timedomain.timesim as ts
     monkeypatch.setattr(ts, "timesim", lambda case, f, progress=None: result([1.34, 0.5]))
-    rec = tf._simulate(None, 36.4, 10.0, "test")
+    rec = tp.simulate(None, 36.4, 10.0, "test")
     assert rec["ok"] and rec["stable"] is False and "unstable by Floquet" in rec["message"]
     rec.update(kind="untraced")
     note = fill_note({"points": [rec], "stretches": [], "skipped": [], "seconds": 1.0, "budget": 30.0}, [1])

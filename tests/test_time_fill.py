@@ -75,16 +75,26 @@ def test_a_stop_short_of_the_window_is_answered_by_time_simulations(stopped, tmp
     assert res.status == "failed"                    # the window's start is not reached (module doc)
     (a, b), = untraced_stretches(res)
     assert a == 0.086 and 0.09 < b < 0.11
-    # 3 points: 2 in the stretch (0.086 Hz settles in 39 periods), 1 check of the traced point
-    # next to the stop (estimated 62 % off; from rest it settles in 77 periods)
+    # 3 points: 2 in the stretch (0.086 Hz from rest settles in 39 periods), 1 check of the
+    # traced point next to the stop (estimated 62 % off; from rest it settles in 77 periods)
     rec = fill_untraced(case, res, budget=20.0, max_points=3)
     assert res.settings["time_fill"] is rec and rec["skipped"] == []
     untraced = [p for p in rec["points"] if p["kind"] == "untraced"]
     check, = [p for p in rec["points"] if p["kind"] == "check"]
     assert [p["freq_hz"] for p in untraced] == pytest.approx([a, (a + b) / 2])
-    first = untraced[0]
+    first, middle = untraced
     assert first["ok"] and first["error_estimate"] < 1e-3
-    assert first["h1"]["x"] == pytest.approx(hbm.timesim(case, a).h1["x"], rel=1e-12)
+    # walked into the stretch by shooting: the middle point from the traced point at the stop,
+    # the window's start from the middle point's solution; the motion from rest settles on the
+    # same periodic solution (1.5e-6 apart: two methods, each with its estimate)
+    assert middle["method"] == first["method"] == "shooting" and first["stable"]
+    assert f"the traced point at {b:.6g} Hz" in middle["message"]
+    assert f"the periodic solution at {(a + b) / 2:.6g} Hz" in first["message"]
+    from_rest = hbm.timesim(case, a)
+    assert first["periods"] < from_rest.periods / 2
+    assert first["h1"]["x"] == pytest.approx(from_rest.h1["x"], rel=max(first["error_estimate"],
+                                                                        from_rest.error_estimate))
+    assert "2 of the untraced shot from the traced path" in rec["note"]
     assert first["h1"]["x"] > 0.85                   # the HBM point next to the stop has 0.80
     # the check: the HBM's point against the time domain at its frequency
     i = int(np.argmin(np.abs(res.freq_hz - b)))
@@ -154,13 +164,13 @@ def test_hbm_frf_writes_the_time_domain_points_and_says_where(tmp_path):
 
 def test_a_refused_or_failed_integration_is_recorded_not_raised(monkeypatch):
     import hbm.timedomain.timesim as ts
-    from hbm.analyses import time_fill
+    from hbm.analyses import time_points
     from hbm.interface.case import CaseError
 
     def refuse(case, f, progress=None):
         raise CaseError("the time history needs 40 GB") if f < 1 else RuntimeError("Newton did not converge")
     monkeypatch.setattr(ts, "timesim", refuse)
-    p, q = time_fill._simulate(None, 0.5, 1.0, "x"), time_fill._simulate(None, 2.0, 1.0, "x")
+    p, q = time_points.simulate(None, 0.5, 1.0, "x"), time_points.simulate(None, 2.0, 1.0, "x")
     assert not p["ok"] and "40 GB" in p["message"] and not q["ok"] and "Newton" in q["message"]
 
 
@@ -194,3 +204,34 @@ def test_a_condensed_model_with_a_velocity_law_is_not_filled_and_that_is_said():
     res = hbm.frf(cond, stability=False)
     assert time_fill._time_model(cond, res) is None
     assert "velocity-dependent law is not integrated in time" in res.settings["time_fill_note"]
+
+
+def test_a_walk_shoots_again_a_point_that_failed_once_a_nearer_start_is_found(monkeypatch):
+    """Points 0.9, 0.7, 0.55 Hz of a stretch below a path traced at 1 Hz: each is shot from the
+    nearest solution known; 0.7 fails from 0.9's (a jump between them), 0.55 converges from
+    0.9's, and 0.7 is then shot again from 0.55's, the nearer start, instead of integrated from
+    rest; a point that fails from every start is integrated from rest."""
+    from types import SimpleNamespace
+    from hbm.analyses import time_points
+    calls = []
+
+    def shoot(case, basis, X, f, problem, start):
+        calls.append((f, start))
+        if f == 0.3 or (f == 0.7 and "0.55" not in start):
+            return None, None
+        return {"freq_hz": f, "ok": True, "method": "shooting", "message": start}, np.full((3, 1), f)
+
+    def from_rest(model, f, seconds, why):
+        calls.append((f, "rest"))
+        return {"freq_hz": f, "ok": False, "message": "not periodic"}
+    monkeypatch.setattr(time_points, "shoot_point", shoot)
+    monkeypatch.setattr(time_points, "simulate", from_rest)
+    res = SimpleNamespace(freq_hz=np.array([1.0]), X=np.zeros((1, 3, 1)), basis=None)
+    run = time_points.FillRun(None, res, None, None, 30.0, None, 3)
+    run.untraced([0.55, 0.7, 0.9])
+    assert calls == [(0.9, "the traced point at 1 Hz"), (0.7, "the periodic solution at 0.9 Hz"),
+                     (0.55, "the periodic solution at 0.9 Hz"), (0.7, "the periodic solution at 0.55 Hz")]
+    assert sorted(p["freq_hz"] for p in run.points) == [0.55, 0.7, 0.9] and all(p["ok"] for p in run.points)
+    calls.clear()
+    run.untraced([0.3])                     # nearest start 0.55: fails, and no other is nearer
+    assert calls == [(0.3, "the periodic solution at 0.55 Hz"), (0.3, "rest")]

@@ -5,23 +5,27 @@ When the continuation stops short or restarts past a gap, the stretches of
 response there cannot be represented with the retained harmonics (a contact that sticks for
 most of the period and slips in short bursts: the truncated displacement rings by more than
 the contact's stick range :math:`2 F_s / k_t`, so the penalty law chatters and Newton stalls),
-more continuation cannot help, but the time integration can: :func:`fill_untraced` runs the
-steady-state time simulation (:func:`hbm.timedomain.timesim.timesim`, Newmark with located
-switches and an ``n`` / ``2 n`` error estimate) at points spread over the untraced stretches,
-within a time budget.  A condensed model is simulated on the model its balance solves, the
-kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`).  The points are
-kept apart from the HBM path (``settings["time_fill"]``, ``frf_timedomain.csv``, markers in
-``frf.png``): they carry no harmonic coefficients.
+more continuation cannot help, but the time domain can: :func:`fill_untraced` finds the
+periodic solutions at points spread over the untraced stretches, within a time budget, and
+checks the traced points estimated more than ``UNRELIABLE`` off (up to a third of the points
+when there are some; each check's record holds the HBM's first harmonics beside the time
+domain's, and how far apart they are).  A condensed model is simulated on the model its
+balance solves, the kept modes and residual flexibility (:mod:`hbm.timedomain.condensed_twin`).
+The points are kept apart from the HBM path (``settings["time_fill"]``, ``frf_timedomain.csv``,
+markers in ``frf.png``): they carry no harmonic coefficients.
 
-The same simulations check the traced points estimated more than ``UNRELIABLE`` off (up to a
-third of the points when there are some): each such point's record holds the HBM's first
-harmonics beside the time domain's, and how far apart they are.  A check shoots from the
-traced point itself (:func:`hbm.timedomain.floquet_check.check_point`: Newton on the period
-map, ``n`` and ``2 n`` steps per period for the error estimate), so it finds the periodic
-solution of the same branch in a few periods, with its Floquet verdict; a lightly damped
-rig integrated from rest may take thousands of periods (the UPD flanks rig: not periodic
-after 224 periods in 7.5 s) or settle on another branch.  Where shooting does not converge
-(a non-smooth period map near a fold), the check is integrated from rest instead.
+Each point is found by shooting (:func:`hbm.timedomain.floquet_check.check_point`: Newton on
+the period map, ``n`` and ``2 n`` steps per period for the error estimate), with its Floquet
+verdict: a check from the traced point itself; a point of an untraced stretch from the
+nearest solution known, a traced point or one its neighbours' shots found, walking into the
+stretch from the traced path (a shot that fails is tried again after the walk from a start
+that has become nearer, e.g. past a jump).  It converges in a few periods where a lightly
+damped rig integrated from rest takes hundreds or thousands (the UPD flanks rig: not
+periodic after 224 periods in 7.5 s; the undamped Jenkins oscillator at kt / k = 1e6: 5 of
+12 points settled in 30 s from rest, 11 of 12 in 12.5 s by the walk), or settles on another
+branch.  Where shooting does not converge (a non-smooth period map near a fold), the point is
+integrated from rest (:func:`hbm.timedomain.timesim.timesim`, Newmark with located switches
+and an ``n`` / ``2 n`` error estimate) for at most ``POINT_SHARE`` of the budget (:mod:`hbm.analyses.time_points`).
 
 A stretch is ``[a, b]`` with ``a`` and ``b`` the ends of the traced spans around it (or the
 window's ends); its points sit at the window's end when the stretch reaches it, else at
@@ -34,10 +38,11 @@ import time
 
 import numpy as np
 
+from hbm.analyses.time_points import FillRun
+
 MIN_WIDTH = 1e-4        # stretches narrower than this share of the window get no point
 BUDGET_SECONDS = 30.0   # time simulations stop being started after this
 MAX_POINTS = 12         # simulations in all (stretches and checks)
-POINT_SHARE = 0.25      # a point that has not settled after this share of the budget is abandoned
 LARGE_ERROR = 0.1       # a traced point next to a stretch estimated this far off is named
 UNRELIABLE = 0.2        # traced points estimated this far off are checked in the time domain
 ROUND_OFF = 1e-12       # of fmax: a stretch this narrow is the round-off of a solved window end
@@ -120,35 +125,6 @@ def _neighbour_errors(res, a: float, b: float) -> list:
     return out
 
 
-class _OutOfTime(Exception):
-    """Raised from a time simulation's progress callback past its deadline."""
-
-
-def _simulate(case, f: float, seconds: float, why: str) -> dict:
-    """One steady-state time simulation at ``f`` Hz as a JSON-friendly record, abandoned
-    (``ok`` False) after about ``seconds`` (``why``: what limited them)."""
-    from hbm.interface.case import CaseError
-    from hbm.timedomain.timesim import timesim
-    t0 = time.perf_counter()
-
-    def watch(periods, change):
-        if time.perf_counter() - t0 > seconds:
-            raise _OutOfTime(f"not periodic after {periods} periods in {seconds:.1f} s ({why})")
-    try:
-        r = timesim(case, f, progress=watch)
-    except (RuntimeError, CaseError, _OutOfTime) as exc:      # a failed or refused integration
-        return {"freq_hz": f, "ok": False, "message": str(exc), "seconds": time.perf_counter() - t0}
-    rec = {"freq_hz": f, "ok": bool(r.converged), "h1": dict(r.h1), "max": dict(r.max),
-           "error_estimate": float(r.error_estimate), "periods": int(r.periods),
-           "seconds": time.perf_counter() - t0,
-           "message": "" if r.converged else f"not periodic to tolerance after {r.periods} periods"}
-    if r.converged and r.shot_unstable is not None:       # a periodic solution, not a settled motion
-        rec.update(stable=False, largest_multiplier=r.shot_unstable,
-                   message=f"found by shooting, unstable by Floquet (largest |multiplier| {r.shot_unstable:.4g}): "
-                           f"a motion from rest leaves it")
-    return rec
-
-
 def spread_order(n: int) -> list:
     """Indices ``0 .. n-1`` in an order that covers the range early (bit-reversed), so that a
     budget that runs out leaves the simulated points spread out."""
@@ -182,44 +158,6 @@ def wanted(res) -> bool:
     worst = _worst_errors(res)
     return (res.status != "finished" or bool(res.settings.get("gaps"))
             or (worst is not None and bool(np.nanmax(worst) > UNRELIABLE)))
-
-
-def _shoot(case, res, problem, i: int) -> dict | None:
-    """The check of path point ``i`` by shooting from it (module doc) as a record like
-    :func:`_simulate`'s, with ``method``, ``stable`` and ``largest_multiplier``; None when
-    shooting cannot be used (a velocity law) or does not converge.
-    ``problem``: the condensed balance the point solves (None for a full model)."""
-    from hbm.timedomain.floquet_check import check_point
-    from hbm.timedomain.time_results import TimeSimOptions
-    t0, f, n = time.perf_counter(), float(res.freq_hz[i]), TimeSimOptions().steps
-    runs = []
-    for steps in (n, 2 * n):
-        try:
-            c = check_point(case, res.basis, res.X[i], f, steps=steps, problem=problem)
-        except ValueError:
-            return None
-        if not c.converged:
-            return None
-        runs.append(c)
-    coarse, fine = runs
-    est = max(abs(a[k] - b[k]) / abs(b[k]) for a, b in ((coarse.h1, fine.h1), (coarse.max, fine.max))
-              for k in b if b[k] != 0.0)
-    return {"freq_hz": f, "ok": True, "h1": fine.h1, "max": fine.max, "error_estimate": float(est),
-            "periods": coarse.periods + fine.periods, "seconds": time.perf_counter() - t0,
-            "message": (f"shot from the traced point; Floquet: {'stable' if fine.stable else 'unstable'} "
-                        f"(largest |multiplier| {fine.largest:.4g})"),
-            "method": "shooting", "stable": bool(fine.stable), "largest_multiplier": float(fine.largest)}
-
-
-def _compare(p: dict, res, i: int, estimate: float) -> dict:
-    """A time-domain point at path point ``i`` (estimated ``estimate`` off), with the HBM's
-    first harmonics beside it."""
-    hbm = {n: float(o.h1[i]) for n, o in res.outputs.items()}
-    p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(estimate)}
-    if p["ok"]:
-        p["hbm_off"] = max((abs(hbm[n] / p["h1"][n] - 1.0) for n in hbm if p["h1"][n] != 0.0),
-                           default=float("nan"))
-    return p
 
 
 def _condensed_problem(case, res):
@@ -286,33 +224,20 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     worst = _worst_errors(res)
     n_checks = max_points // 3 if worst is not None and np.any(worst > UNRELIABLE) else 0
     freqs = fill_frequencies(stretches, window, max_points - n_checks)
-    todo = [(f, None) for fs in freqs for f in fs]
-    todo += [(float(res.freq_hz[i]), i) for i in check_points(res, max_points - len(todo), worst)]
-    if not todo:
+    walk = [f for fs in freqs for f in fs]
+    checks = check_points(res, max_points - len(walk), worst)
+    if not walk and not checks:
         return None
-    t0, points, skipped = time.perf_counter(), [], []
-    for k in spread_order(len(todo)):
-        f, i = todo[k]
-        left = budget - (time.perf_counter() - t0)
-        if left <= 0:
-            skipped.append(f)
-            continue
-        shot = None if i is None else _shoot(case, res, problem, i)
-        left = budget - (time.perf_counter() - t0)      # a shot that did not converge took its time
-        share = POINT_SHARE * budget
-        why = "a point's share of the budget" if share < left else "the budget ran out"
-        if shot is None and left <= 0:
-            skipped.append(f)
-            continue
-        p = {"kind": "untraced", **(shot or _simulate(model, f, min(left, share), why))}
-        points.append(p if i is None else _compare(p, res, i, worst[i]))
-        if progress is not None:
-            progress(len(points), len(todo))
+    run = FillRun(case, res, problem, model, budget, progress, len(walk) + len(checks))
+    run.untraced(walk)
+    for k in spread_order(len(checks)):
+        run.check(checks[k], worst[checks[k]])
+    points, skipped = run.points, run.skipped
     points.sort(key=lambda p: p["freq_hz"])
     skipped.sort()
     record = {"stretches": [{"a_hz": a, "b_hz": b, "neighbour_errors": _neighbour_errors(res, a, b)}
                             for (a, b), fs in zip(stretches, freqs) if fs],
-              "points": points, "skipped": skipped, "seconds": time.perf_counter() - t0, "budget": budget}
+              "points": points, "skipped": skipped, "seconds": time.perf_counter() - run.t0, "budget": budget}
     record["note"] = fill_note(record, res.settings.get("harmonics", []))
     res.settings["time_fill"] = record
     return record
@@ -328,9 +253,13 @@ def fill_note(record: dict, harmonics) -> str:
     where += [f"{len(checks)} traced point{'s' * (len(checks) > 1)} estimated over {100 * UNRELIABLE:.0f} % "
               f"off"] if checks else []
     note = (f"{' and '.join(where)}: {len(ok)} of {len(record['points']) + len(record['skipped'])} "
-            f"time-domain points (hbm timesim, {record['seconds']:.1f} s) in frf_timedomain.csv")
+            f"time-domain points ({record['seconds']:.1f} s) in frf_timedomain.csv")
     if ok:
         note += f", estimated error up to {max(p['error_estimate'] for p in ok):.1e}"
+    walked = [p for p in ok if p["kind"] != "check" and p.get("method") == "shooting"]
+    if walked:
+        note += (f"; {len(walked)} of the untraced shot from the traced path or a periodic solution found "
+                 f"next to them")
     shaky = [p for p in ok if p["kind"] != "check" and p.get("stable") is False]
     if shaky:
         at = ", ".join(f"{p['freq_hz']:.6g}" for p in shaky[:3])

@@ -12,7 +12,9 @@ untraced or a point is estimated far off (:mod:`hbm.analyses.time_fill`; filled:
 harmonic, open: max).  A panel below draws that estimated error on a log scale with 1 %
 marked; a lower panel, when the case asks for element outputs
 (``"ELEMENT.QUANTITY"``, e.g. a contact's slip fraction or normal load), draws them against
-the same frequency axis.
+the same frequency axis.  The frequency axis is logarithmic when the window spans two
+decades or more (``LOG_AXIS_SPAN``: a stuck contact's resonance a thousand times above the
+free one), else linear.
 """
 from __future__ import annotations
 
@@ -21,6 +23,9 @@ from pathlib import Path
 import numpy as np
 
 JUMP_COLOURS = {"up": "tab:red", "down": "tab:blue"}
+
+
+LOG_AXIS_SPAN = 100.0   # a window spanning this ratio of frequencies or more is drawn on a log axis
 
 
 def gap_starts(settings: dict) -> list:
@@ -167,7 +172,10 @@ def write_plot(res, path: Path, title: str, scale: float = 1.0, unit: str = "m/N
         ex.legend(fontsize=7)
     axes[-1, 0].set_xlabel("frequency (Hz)")
     if "fmin_hz" in res.settings and "fmax_hz" in res.settings:      # the whole window, traced or not
-        axes[-1, 0].set_xlim(res.settings["fmin_hz"], res.settings["fmax_hz"])
+        lo, hi = res.settings["fmin_hz"], res.settings["fmax_hz"]
+        if lo > 0 and hi / lo >= LOG_AXIS_SPAN:      # decades: a linear axis crams the low ones
+            axes[-1, 0].set_xscale("log")
+        axes[-1, 0].set_xlim(lo, hi)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -79,6 +79,10 @@ class FloquetCheck:
         over its last period (:func:`hbm.timedomain.time_results.period_amplitudes`).
     periods : int
         Periods integrated.
+    X : ndarray, shape (n_coef, n), or None
+        The time solution's last period projected on the balance's basis (least squares on
+        the step grid), for a full model: the start of a shot at a neighbouring frequency
+        (:mod:`hbm.analyses.time_fill`); None for a condensed one.
     """
 
     stable: bool
@@ -89,6 +93,7 @@ class FloquetCheck:
     h1: dict
     max: dict
     periods: int
+    X: np.ndarray | None = None
 
 
 def _start_states(packed, G_all_q: np.ndarray):
@@ -175,10 +180,13 @@ def check_point(case, basis: FourierBasis, X: np.ndarray, freq_hz: float, steps:
     q_hb = basis_matrix(basis.h_of_row, theta) @ Xm
     q_td = periods[-1]
     h1, mx = period_amplitudes(model, q_td, theta / w, w)
+    X_td = None
     if model is not case:           # compare the contact motion u = B y
         q_hb, q_td = q_hb @ model.B.T, q_td @ model.B.T
+    else:
+        X_td = np.linalg.lstsq(basis_matrix(basis.h_of_row, theta[:-1]), q_td[:-1], rcond=None)[0]
     dist = float(np.abs(q_td - q_hb).max() / max(np.abs(q_hb).max(), 1e-300))
-    return FloquetCheck(stable, big, shot.converged, dist, shot.message, h1, mx, len(periods))
+    return FloquetCheck(stable, big, shot.converged, dist, shot.message, h1, mx, len(periods), X_td)
 
 
 MAX_CONFIRM = 40            # Hill-unstable points checked per FRF at least, if there are so many,

@@ -1,0 +1,178 @@
+r"""One time-domain point of the time fill (:mod:`hbm.analyses.time_fill`): a periodic solution
+by shooting, or a steady state integrated from rest.
+
+Shooting solves :math:`y_0 = \Phi_T(y_0)` for the state at the start of a period by Newton
+on the period map :math:`\Phi_T` of the time integrator
+(:func:`hbm.timedomain.floquet_check.check_point`), at ``n`` and ``2 n`` steps per period;
+the relative difference of their first harmonics and peaks is the point's error estimate, the
+monodromy matrix's multipliers its Floquet verdict.  :class:`FillRun` runs a fill's points
+within its budget: the points of an untraced stretch walk into it from the traced path, each
+shot from the nearest solution known (a traced point, or what a neighbour's shot found); the
+checks of far-off traced points shoot from the points themselves.  A point whose shot fails is
+integrated from rest (:func:`hbm.timedomain.timesim.timesim`) for at most ``POINT_SHARE`` of
+the budget.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+POINT_SHARE = 0.25      # a point that has not settled after this share of the budget is abandoned
+
+
+class _OutOfTime(Exception):
+    """Raised from a time simulation's progress callback past its deadline."""
+
+
+def simulate(case, f: float, seconds: float, why: str) -> dict:
+    """One steady-state time simulation at ``f`` Hz as a JSON-friendly record, abandoned
+    (``ok`` False) after about ``seconds`` (``why``: what limited them)."""
+    from hbm.interface.case import CaseError
+    from hbm.timedomain.timesim import timesim
+    t0 = time.perf_counter()
+
+    def watch(periods, change):
+        if time.perf_counter() - t0 > seconds:
+            raise _OutOfTime(f"not periodic after {periods} periods in {seconds:.1f} s ({why})")
+    try:
+        r = timesim(case, f, progress=watch)
+    except (RuntimeError, CaseError, _OutOfTime) as exc:      # a failed or refused integration
+        return {"freq_hz": f, "ok": False, "message": str(exc), "seconds": time.perf_counter() - t0}
+    rec = {"freq_hz": f, "ok": bool(r.converged), "h1": dict(r.h1), "max": dict(r.max),
+           "error_estimate": float(r.error_estimate), "periods": int(r.periods),
+           "seconds": time.perf_counter() - t0,
+           "message": f"integrated from rest: periodic after {r.periods} periods" if r.converged else f"not periodic to tolerance after {r.periods} periods"}
+    if r.converged and r.shot_unstable is not None:       # a periodic solution, not a settled motion
+        rec.update(stable=False, largest_multiplier=r.shot_unstable,
+                   message=f"found by shooting, unstable by Floquet (largest |multiplier| {r.shot_unstable:.4g}): "
+                           f"a motion from rest leaves it")
+    return rec
+
+
+def shoot_point(case, basis, X, f: float, problem, start: str):
+    """A periodic solution at ``f`` Hz found by shooting from the balance coefficients ``X``
+    (n_coef, n) (module doc), as a record like :func:`simulate`'s with ``method``, ``stable``
+    and ``largest_multiplier``, and the solution's own coefficients (None for a condensed
+    model); ``(None, None)`` when shooting cannot be used (a velocity law) or does not
+    converge.  ``start`` names where ``X`` comes from; ``problem``: the condensed balance
+    (None for a full model)."""
+    from hbm.timedomain.floquet_check import check_point
+    from hbm.timedomain.time_results import TimeSimOptions
+    t0, n = time.perf_counter(), TimeSimOptions().steps
+    runs = []
+    for steps in (n, 2 * n):
+        try:
+            c = check_point(case, basis, X, f, steps=steps, problem=problem)
+        except ValueError:
+            return None, None
+        if not c.converged:
+            return None, None
+        runs.append(c)
+    coarse, fine = runs
+    est = max(abs(a[k] - b[k]) / abs(b[k]) for a, b in ((coarse.h1, fine.h1), (coarse.max, fine.max))
+              for k in b if b[k] != 0.0)
+    return ({"freq_hz": f, "ok": True, "h1": fine.h1, "max": fine.max, "error_estimate": float(est),
+             "periods": coarse.periods + fine.periods, "seconds": time.perf_counter() - t0,
+             "message": (f"shot from {start}; Floquet: {'stable' if fine.stable else 'unstable'} "
+                         f"(largest |multiplier| {fine.largest:.4g})"),
+             "method": "shooting", "stable": bool(fine.stable), "largest_multiplier": float(fine.largest)},
+            fine.X)
+
+
+def compare(p: dict, res, i: int, estimate: float) -> dict:
+    """A time-domain point at path point ``i`` (estimated ``estimate`` off), with the HBM's
+    first harmonics beside it."""
+    hbm = {n: float(o.h1[i]) for n, o in res.outputs.items()}
+    p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(estimate)}
+    if p["ok"]:
+        p["hbm_off"] = max((abs(hbm[n] / p["h1"][n] - 1.0) for n in hbm if p["h1"][n] != 0.0),
+                           default=float("nan"))
+    return p
+
+
+def distance(res, f: float) -> float:
+    """Distance (Hz) from ``f`` to the nearest traced point of ``res`` (inf without any)."""
+    return float(np.min(np.abs(res.freq_hz - f))) if res.freq_hz.size else np.inf
+
+
+class FillRun:
+    """The simulations of one fill within its budget: ``points`` and ``skipped`` (Hz) so far,
+    and the periodic solutions its shots found (Hz -> coefficients), which later shots in the
+    untraced stretches start from when they are nearer than the traced path (a walk into the
+    stretch: a shot from a far start may not converge, e.g. 0.0796 Hz from 0.1265 Hz on the
+    undamped Jenkins oscillator at kt / k = 1e6)."""
+
+    def __init__(self, case, res, problem, model, budget, progress, total):
+        self.case, self.res, self.problem, self.model = case, res, problem, model
+        self.budget, self.progress, self.total = budget, progress, total
+        self.t0, self.points, self.skipped, self.known = time.perf_counter(), [], [], {}
+
+    def _left(self) -> float:
+        return self.budget - (time.perf_counter() - self.t0)
+
+    def _start(self, f: float):
+        """``(X, description)`` of the nearest known solution to ``f``: a traced point or a
+        converged shot; ``(None, "")`` when there is neither."""
+        d_path = distance(self.res, f)
+        g = min(self.known, key=lambda k: abs(k - f), default=None)
+        if g is not None and abs(g - f) < d_path:
+            return self.known[g], f"the periodic solution at {g:.6g} Hz"
+        if not np.isfinite(d_path):
+            return None, ""
+        i = int(np.argmin(np.abs(self.res.freq_hz - f)))
+        return self.res.X[i], f"the traced point at {self.res.freq_hz[i]:.6g} Hz"
+
+    def untraced(self, freqs: list) -> None:
+        """The points ``freqs`` (Hz) of the untraced stretches, nearest the traced path first:
+        each shot from the nearest known solution; one whose shot fails is shot again after
+        the others from a start that is now nearer (a solution found beyond it: the walk
+        passes a jump), else integrated from rest."""
+        deferred = []
+        for f in sorted(freqs, key=lambda f: distance(self.res, f)):
+            if self._left() <= 0:
+                self.skipped.append(f)
+                continue
+            X, start = self._start(f)
+            if not self._shot(f, X, start):
+                deferred.append((f, start))
+        for f, tried in deferred:
+            if self._left() <= 0:
+                self.skipped.append(f)
+                continue
+            X, start = self._start(f)
+            if start == tried or not self._shot(f, X, start):
+                self._add(f, None)
+
+    def _shot(self, f: float, X, start: str) -> bool:
+        """Shoot at ``f`` from ``X`` (nothing without one); a converged shot is kept as a
+        point and as a start.  Returns whether it converged."""
+        shot, X_shot = (None, None) if X is None else shoot_point(self.case, self.res.basis, X, f, self.problem, start)
+        if shot is None:
+            return False
+        if X_shot is not None:
+            self.known[f] = X_shot
+        self._add(f, shot)
+        return True
+
+    def check(self, i: int, estimate: float) -> None:
+        """The check of path point ``i`` (estimated ``estimate`` off): shot from it, else
+        integrated from rest."""
+        f = float(self.res.freq_hz[i])
+        if self._left() <= 0:
+            self.skipped.append(f)
+            return
+        self._add(f, shoot_point(self.case, self.res.basis, self.res.X[i], f, self.problem, "the traced point")[0],
+                  i, estimate)
+
+    def _add(self, f, shot, i=None, estimate=None) -> None:
+        left = self._left()                  # a shot that did not converge took its time
+        share = POINT_SHARE * self.budget
+        why = "a point's share of the budget" if share < left else "the budget ran out"
+        if shot is None and left <= 0:
+            self.skipped.append(f)
+            return
+        p = {"kind": "untraced", **(shot or simulate(self.model, f, min(left, share), why))}
+        self.points.append(p if i is None else compare(p, self.res, i, estimate))
+        if self.progress is not None:
+            self.progress(len(self.points), self.total)
