@@ -77,7 +77,7 @@ def test_a_stop_short_of_the_window_is_answered_by_time_simulations(stopped, tmp
     assert a == 0.086 and 0.09 < b < 0.11
     # 3 points: 2 in the stretch (0.086 Hz from rest settles in 39 periods), 1 check of the
     # traced point next to the stop (estimated 62 % off; from rest it settles in 77 periods)
-    rec = fill_untraced(case, res, budget=20.0, max_points=3)
+    rec = fill_untraced(case, res, budget=20.0, max_points=3, refine_points=0)
     assert res.settings["time_fill"] is rec and rec["skipped"] == []
     untraced = [p for p in rec["points"] if p["kind"] == "untraced"]
     check, = [p for p in rec["points"] if p["kind"] == "check"]
@@ -103,8 +103,11 @@ def test_a_stop_short_of_the_window_is_answered_by_time_simulations(stopped, tmp
     assert check["ok"] and check["hbm_off"] == pytest.approx(abs(res.outputs["x"].h1[i] / check["h1"]["x"] - 1))
     assert 0.05 < check["hbm_off"] < check["hbm_estimate"]     # off indeed, within its estimate
     # shot from the traced point: the periodic solution a simulation from rest settles on
-    # (1.8e-7 apart), in 8 periods instead of 77, with its Floquet verdict
-    rest = hbm.timesim(case, check["freq_hz"])
+    # (1.8e-7 apart at the same steps per period: 1024 and 2048, those of a stiff contact's
+    # shots), in 8 periods instead of 77, with its Floquet verdict
+    from hbm.timedomain.floquet_check import FINE_STEPS
+    from hbm.timedomain.time_results import TimeSimOptions
+    rest = hbm.timesim(case, check["freq_hz"], TimeSimOptions(steps=FINE_STEPS))
     assert check["method"] == "shooting" and check["stable"] and check["periods"] < rest.periods / 4
     assert check["h1"]["x"] == pytest.approx(rest.h1["x"], rel=1e-5)
     assert check["error_estimate"] == pytest.approx(rest.error_estimate, rel=0.05)
@@ -185,8 +188,8 @@ def test_a_condensed_model_is_filled_on_the_model_its_balance_solves(stopped):
     # the same run as the full solver's, retried with aft = "events" like it (a stiff contact)
     assert "aft_retry" in rc.settings and rc.freq_hz.size == res.freq_hz.size
     assert np.allclose(rc.outputs["x"].h1, res.outputs["x"].h1, rtol=1e-6)
-    a = fill_untraced(case, res, budget=10.0, max_points=1)
-    b = fill_untraced(cond, rc, budget=10.0, max_points=1)
+    a = fill_untraced(case, res, budget=10.0, max_points=1, refine_points=0)
+    b = fill_untraced(cond, rc, budget=10.0, max_points=1, refine_points=0)
     (pa,), (pb,) = a["points"], b["points"]
     assert pa["freq_hz"] == pb["freq_hz"] == 0.086 and pa["ok"] and pb["ok"]
     assert abs(pb["h1"]["x"] / pa["h1"]["x"] - 1) < 1e-8 and "time_fill_note" not in rc.settings
@@ -235,3 +238,27 @@ def test_a_walk_shoots_again_a_point_that_failed_once_a_nearer_start_is_found(mo
     calls.clear()
     run.untraced([0.3])                     # nearest start 0.55: fails, and no other is nearer
     assert calls == [(0.3, "the periodic solution at 0.55 Hz"), (0.3, "rest")]
+
+
+def test_the_refinement_brackets_a_jump_inside_a_stretch(monkeypatch):
+    """A stretch 0.5..1 Hz below a path traced from 1 Hz (h1 0.19 there, estimated 1 % off),
+    answered at 0.5 (h1 1) and 0.9 Hz (0.2), with a jump at 0.62 Hz: four more points halve
+    the interval across the jump each time (0.7, 0.6, 0.65, 0.625 Hz); the smooth end
+    (0.9 -> 1 Hz, 5 % apart) gets none; a traced end estimated far off is not compared."""
+    from types import SimpleNamespace
+    from hbm.analyses import time_points
+
+    def shoot(case, basis, X, f, problem, start):
+        return {"freq_hz": f, "ok": True, "kind": "untraced", "h1": {"x": 1.0 if f < 0.62 else 0.2},
+                "method": "shooting"}, np.zeros((3, 1))
+    monkeypatch.setattr(time_points, "shoot_point", shoot)
+    out = SimpleNamespace(h1=np.array([0.19]), err=np.array([0.01]))
+    res = SimpleNamespace(freq_hz=np.array([1.0]), X=np.zeros((1, 3, 1)), basis=None, outputs={"x": out})
+    run = time_points.FillRun(None, res, None, None, 30.0, None, 2)
+    run.untraced([0.5, 0.9])
+    assert run.refine([(0.5, 1.0)], 4) == 4
+    assert [p["freq_hz"] for p in run.points[2:]] == pytest.approx([0.7, 0.6, 0.65, 0.625])
+    out.h1[0], out.err[0] = 0.1, 0.5        # the traced end 50 % off: its 0.1 against 0.2 is not a jump
+    run = time_points.FillRun(None, res, None, None, 30.0, None, 2)
+    run.untraced([0.9, 0.95])
+    assert run.refine([(0.5, 1.0)], 4) == 0

@@ -29,7 +29,10 @@ and an ``n`` / ``2 n`` error estimate) for at most ``POINT_SHARE`` of the budget
 
 A stretch is ``[a, b]`` with ``a`` and ``b`` the ends of the traced spans around it (or the
 window's ends); its points sit at the window's end when the stretch reaches it, else at
-interior fractions ``k / (m + 1)``.  Stretches narrower than ``MIN_WIDTH`` of the window (a
+interior fractions ``k / (m + 1)``.  With budget left, up to ``REFINE_POINTS`` more are shot
+one at a time between the two neighbouring answers (traced ends included) whose first
+harmonics differ most, by over ``REFINE_CHANGE`` (5 %): a jump inside a stretch is located
+instead of drawn across.  Stretches narrower than ``MIN_WIDTH`` of the window (a
 corner of the path, e.g. a stuck slider's offset that jumps when it starts to slip) get none.
 """
 from __future__ import annotations
@@ -38,11 +41,12 @@ import time
 
 import numpy as np
 
-from hbm.analyses.time_points import FillRun
+from hbm.analyses.time_points import REFINE_CHANGE, FillRun
 
 MIN_WIDTH = 1e-4        # stretches narrower than this share of the window get no point
 BUDGET_SECONDS = 30.0   # time simulations stop being started after this
-MAX_POINTS = 12         # simulations in all (stretches and checks)
+MAX_POINTS = 12         # simulations in all (stretches and checks) before the refinement
+REFINE_POINTS = 24      # points added after them where neighbouring answers differ most
 LARGE_ERROR = 0.1       # a traced point next to a stretch estimated this far off is named
 UNRELIABLE = 0.2        # traced points estimated this far off are checked in the time domain
 ROUND_OFF = 1e-12       # of fmax: a stretch this narrow is the round-off of a solved window end
@@ -188,7 +192,7 @@ def _time_model(case, res, problem=None):
 
 
 def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = MAX_POINTS,
-                  progress=None) -> dict | None:
+                  progress=None, refine_points: int = REFINE_POINTS) -> dict | None:
     """Time-simulate the stretches of the window that ``res`` left untraced, and the traced
     points estimated more than ``UNRELIABLE`` off (module doc); record them in
     ``res.settings["time_fill"]``.
@@ -200,9 +204,12 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     budget : float
         No simulation is started once this many seconds have been spent.
     max_points : int
-        Simulations in all; a third of them go to the far-off points when there are some.
+        Simulations in all before the refinement; a third of them go to the far-off points
+        when there are some.
     progress : callable, optional
         ``progress(done, total)`` after each simulation.
+    refine_points : int
+        Points the refinement may add (module doc).
 
     Returns
     -------
@@ -211,7 +218,9 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         ``freq_hz``, ``kind`` (``untraced`` / ``check``), ``ok``, per output ``h1`` and ``max``,
         ``error_estimate``, ``periods``, ``seconds``, ``message``; a check also ``hbm_h1``,
         ``hbm_estimate`` and ``hbm_off``, the HBM's largest relative deviation), ``skipped``
-        (frequencies not simulated for the budget), ``seconds``, ``note``; None when there is
+        (frequencies not simulated for the budget), ``refined`` (points added where
+        neighbouring answers differ most, :meth:`FillRun.refine`), ``seconds``, ``budget``,
+        ``note``; None when there is
         nothing to simulate or the model is not simulated here (a condensed model with a
         velocity-dependent law; ``settings["time_fill_note"]`` says so).
     """
@@ -230,17 +239,24 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         return None
     run = FillRun(case, res, problem, model, budget, progress, len(walk) + len(checks))
     run.untraced(walk)
-    for k in spread_order(len(checks)):
-        run.check(checks[k], worst[checks[k]])
+    run.checks([(checks[k], worst[checks[k]]) for k in spread_order(len(checks))])
+    refined = run.refine([s for s, fs in zip(stretches, freqs) if fs], refine_points)
     points, skipped = run.points, run.skipped
     points.sort(key=lambda p: p["freq_hz"])
     skipped.sort()
     record = {"stretches": [{"a_hz": a, "b_hz": b, "neighbour_errors": _neighbour_errors(res, a, b)}
                             for (a, b), fs in zip(stretches, freqs) if fs],
-              "points": points, "skipped": skipped, "seconds": time.perf_counter() - run.t0, "budget": budget}
+              "points": points, "skipped": skipped, "refined": refined,
+              "seconds": time.perf_counter() - run.t0, "budget": budget}
     record["note"] = fill_note(record, res.settings.get("harmonics", []))
     res.settings["time_fill"] = record
     return record
+
+
+def _span(values) -> str:
+    """``"a-b"`` (percent of the relative values), or ``"a"`` for one."""
+    lo, hi = 100 * min(values), 100 * max(values)
+    return f"{lo:.2g}" + ("" if len(values) == 1 else f"-{hi:.2g}")
 
 
 def fill_note(record: dict, harmonics) -> str:
@@ -260,20 +276,24 @@ def fill_note(record: dict, harmonics) -> str:
     if walked:
         note += (f"; {len(walked)} of the untraced shot from the traced path or a periodic solution found "
                  f"next to them")
+    if record.get("refined"):
+        note += f" ({record['refined']} added where neighbouring answers differ by over {100 * REFINE_CHANGE:.0f} %)"
     shaky = [p for p in ok if p["kind"] != "check" and p.get("stable") is False]
     if shaky:
         at = ", ".join(f"{p['freq_hz']:.6g}" for p in shaky[:3])
         note += (f" ({len(shaky)} of them found by shooting and unstable by Floquet, at {at} Hz: periodic "
                  f"solutions a motion from rest leaves)")
-    off = [p["hbm_off"] for p in checks if p["ok"]]
-    if off:
-        span = f"{100 * min(off):.2g}" + ("" if len(off) == 1 else f"-{100 * max(off):.2g}")
-        note += f"; there the HBM's first harmonic is off by {span} %"
-        shot = [p for p in checks if p.get("method") == "shooting"]
-        if shot:
-            unstable = sum(not p["stable"] for p in shot)
-            note += (f" ({len(shot)} shot from the traced point"
-                     + (f", {unstable} of them unstable by Floquet" if unstable else "") + ")")
+    shot = [p for p in checks if p["ok"] and p.get("method") == "shooting"]
+    if shot:
+        unstable = sum(not p["stable"] for p in shot)
+        note += (f"; there the HBM's first harmonic is off by {_span([p['hbm_off'] for p in shot])} % "
+                 f"({len(shot)} shot from the traced point or a neighbouring check's solution"
+                 + (f", {unstable} of them unstable by Floquet" if unstable else "") + ")")
+    rest = [p for p in checks if p["ok"] and p.get("method") != "shooting"]
+    if rest:
+        note += (f"; {len(rest)} check{'s' * (len(rest) > 1)} integrated from rest, where shooting did not "
+                 f"converge, settled {_span([p['hbm_off'] for p in rest])} % away from the HBM's first "
+                 f"harmonic (a motion from rest may settle on another branch than the one traced)")
     bad = [p for p in record["points"] if not p["ok"]]
     if bad:
         note += f"; at {bad[0]['freq_hz']:.6g} Hz {bad[0]['message']}"

@@ -19,6 +19,8 @@ import time
 import numpy as np
 
 POINT_SHARE = 0.25      # a point that has not settled after this share of the budget is abandoned
+REFINE_CHANGE = 0.05    # neighbouring answers of a stretch whose first harmonics differ more get a point between
+REFINE_WIDTH = 1e-3     # ... unless they are closer than this share of their stretch
 
 
 class _OutOfTime(Exception):
@@ -42,7 +44,9 @@ def simulate(case, f: float, seconds: float, why: str) -> dict:
     rec = {"freq_hz": f, "ok": bool(r.converged), "h1": dict(r.h1), "max": dict(r.max),
            "error_estimate": float(r.error_estimate), "periods": int(r.periods),
            "seconds": time.perf_counter() - t0,
-           "message": f"integrated from rest: periodic after {r.periods} periods" if r.converged else f"not periodic to tolerance after {r.periods} periods"}
+           "method": "rest",
+           "message": (f"integrated from rest: periodic after {r.periods} periods" if r.converged
+                       else f"not periodic to tolerance after {r.periods} periods")}
     if r.converged and r.shot_unstable is not None:       # a periodic solution, not a settled motion
         rec.update(stable=False, largest_multiplier=r.shot_unstable,
                    message=f"found by shooting, unstable by Floquet (largest |multiplier| {r.shot_unstable:.4g}): "
@@ -55,20 +59,27 @@ def shoot_point(case, basis, X, f: float, problem, start: str):
     (n_coef, n) (module doc), as a record like :func:`simulate`'s with ``method``, ``stable``
     and ``largest_multiplier``, and the solution's own coefficients (None for a condensed
     model); ``(None, None)`` when shooting cannot be used (a velocity law) or does not
-    converge.  ``start`` names where ``X`` comes from; ``problem``: the condensed balance
+    converge at two step counts in a row of ``n``, ``2 n``, ``4 n`` (``n`` the time
+    integrator's default, at least ``FINE_STEPS`` with stiff contacts: a non-smooth period map
+    that stalls Newton at 1024 steps may not at 2048).  ``start`` names where ``X`` comes from; ``problem``: the condensed balance
     (None for a full model)."""
-    from hbm.timedomain.floquet_check import check_point
+    from hbm.model.contact_stiffness import stiff_contacts
+    from hbm.timedomain.floquet_check import FINE_STEPS, check_point
     from hbm.timedomain.time_results import TimeSimOptions
     t0, n = time.perf_counter(), TimeSimOptions().steps
+    if stiff_contacts(case):        # as the Floquet checks: at 512 steps Newton stalls on the
+        n = max(n, FINE_STEPS)      # separating point contact kn = 1000 (4.5e-5), at 1024 it converges
     runs = []
-    for steps in (n, 2 * n):
+    for steps in (n, 2 * n, 4 * n):     # the first two converged levels in a row
         try:
             c = check_point(case, basis, X, f, steps=steps, problem=problem)
         except ValueError:
             return None, None
-        if not c.converged:
-            return None, None
-        runs.append(c)
+        runs = runs + [c] if c.converged else []
+        if len(runs) == 2 or (steps == 2 * n and not runs):
+            break
+    if len(runs) < 2:
+        return None, None
     coarse, fine = runs
     est = max(abs(a[k] - b[k]) / abs(b[k]) for a, b in ((coarse.h1, fine.h1), (coarse.max, fine.max))
               for k in b if b[k] != 0.0)
@@ -155,15 +166,86 @@ class FillRun:
         self._add(f, shot)
         return True
 
-    def check(self, i: int, estimate: float) -> None:
-        """The check of path point ``i`` (estimated ``estimate`` off): shot from it, else
-        integrated from rest."""
-        f = float(self.res.freq_hz[i])
-        if self._left() <= 0:
-            self.skipped.append(f)
-            return
-        self._add(f, shoot_point(self.case, self.res.basis, self.res.X[i], f, self.problem, "the traced point")[0],
-                  i, estimate)
+    def refine(self, stretches: list, most: int) -> int:
+        """Up to ``most`` more points in the untraced ``stretches`` ((a, b) Hz each), one at a
+        time at the middle of the two neighbouring answers (a traced end or a converged point)
+        whose first harmonics differ most, by more than ``REFINE_CHANGE`` (a traced end only
+        if estimated within that); each shot from the
+        nearest known solution, none integrated from rest.  Stops while a point's share of
+        the budget is left.  Returns the points added."""
+        added, failed = 0, set()
+        while added < most and self._left() > POINT_SHARE * self.budget:
+            pair = self._largest_change(stretches, failed)
+            if pair is None:
+                break
+            f = 0.5 * (pair[0] + pair[1])
+            self.total = max(self.total, len(self.points) + 1)
+            X, start = self._start(f)
+            if X is not None and self._shot(f, X, start):
+                added += 1
+            else:
+                failed.add(pair)
+        return added
+
+    def _largest_change(self, stretches, failed):
+        """``(f_a, f_b)``: the neighbouring answers of a stretch, not in ``failed``, whose first
+        harmonics differ most (relative, largest over the outputs), if by more than
+        ``REFINE_CHANGE``; None otherwise."""
+        res, best, pair = self.res, REFINE_CHANGE, None
+        for a, b in stretches:
+            nodes = [(p["freq_hz"], p["h1"]) for p in self.points
+                     if p["ok"] and p["kind"] == "untraced" and a <= p["freq_hz"] <= b]
+            for end in (a, b):          # a traced end, unless estimated too far off to compare
+                i = int(np.argmin(np.abs(res.freq_hz - end))) if res.freq_hz.size else -1
+                if i >= 0 and distance(res, end) <= 1e-9 * end and self._reliable(i):
+                    nodes.append((end, {n: float(o.h1[i]) for n, o in res.outputs.items()}))
+            nodes.sort(key=lambda t: t[0])
+            for (fa, ha), (fb, hb) in zip(nodes[:-1], nodes[1:]):
+                if fb - fa <= REFINE_WIDTH * (b - a) or (fa, fb) in failed:
+                    continue
+                change = max((abs(ha[n] - hb[n]) / max(abs(ha[n]), abs(hb[n]), 1e-300) for n in ha), default=0.0)
+                if change > best:
+                    best, pair = change, (fa, fb)
+        return pair
+
+    def _reliable(self, i: int) -> bool:
+        """Traced point ``i`` is estimated within ``REFINE_CHANGE`` (or carries no estimate)."""
+        errs = [o.err[i] for o in self.res.outputs.values() if getattr(o, "err", None) is not None]
+        return not errs or bool(np.nan_to_num(max(errs), nan=np.inf) <= REFINE_CHANGE)
+
+    def checks(self, items: list) -> None:
+        """The checks of path points ``items`` ((i, estimate) each, in the order given): each
+        shot from its traced point; those whose shots fail are shot again after the others,
+        nearest first, from the nearest periodic solution found (a neighbouring check's or a
+        stretch point's: a traced point estimated far off may be too far for Newton to start
+        from), else
+        integrated from rest, which may settle on another branch (``method`` "rest")."""
+        deferred = []
+        for i, estimate in items:
+            f = float(self.res.freq_hz[i])
+            if self._left() <= 0:
+                self.skipped.append(f)
+                continue
+            shot, X_shot = shoot_point(self.case, self.res.basis, self.res.X[i], f, self.problem, "the traced point")
+            if shot is None:
+                deferred.append((i, estimate))
+                continue
+            if X_shot is not None:
+                self.known[f] = X_shot
+            self._add(f, shot, i, estimate)
+        while deferred:             # a walk: the one nearest a solution found first
+            gap = lambda item: min((abs(k - self.res.freq_hz[item[0]]) for k in self.known), default=0.0)  # noqa: E731
+            i, estimate = deferred.pop(min(range(len(deferred)), key=lambda j: gap(deferred[j])))
+            f = float(self.res.freq_hz[i])
+            if self._left() <= 0:
+                self.skipped.append(f)
+                continue
+            g = min(self.known, key=lambda k: abs(k - f), default=None)
+            shot, X_shot = (None, None) if g is None else shoot_point(
+                self.case, self.res.basis, self.known[g], f, self.problem, f"the periodic solution at {g:.6g} Hz")
+            if X_shot is not None:
+                self.known[f] = X_shot
+            self._add(f, shot, i, estimate)
 
     def _add(self, f, shot, i=None, estimate=None) -> None:
         left = self._left()                  # a shot that did not converge took its time
