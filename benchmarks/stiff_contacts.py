@@ -3,7 +3,9 @@
 Each case runs ``hbm.frf`` with its defaults (stability off, as the issue ran them) and once
 more with ``aft = "events"`` (exact switches, no sampling); where a run stops, leaves gaps or
 has points estimated over 20 % off, the time fill of ``hbm frf`` (30 s) runs on it, and the
-points that settled and how far off the checked HBM points are go to the table.  Printed and
+points that settled (of them, how many the refinement added), how far off the checked HBM
+points are where the check shot its periodic solution, and how many checks were integrated
+from rest instead (those may settle on another branch: not compared) go to the table.  Printed and
 written to benchmarks/results/stiff_contacts.csv: status, the harmonics of the run kept (H, richer
 than the case's where a stop was blamed on them, :mod:`hbm.analyses.harmonics_retry`), points, largest energy-balance
 error, CPU seconds, and for the Jenkins SDOF with viscous damping the largest error against
@@ -87,10 +89,13 @@ def time_fill(case, res) -> dict:
     """What ``hbm frf``'s time fill (30 s) finds where the run stopped, left gaps or is far off."""
     rec = fill_untraced(case, res) if wanted(res) else None
     if rec is None:
-        return {"fill_settled": "", "fill_points": 0, "fill_hbm_off": ""}
-    off = [p["hbm_off"] for p in rec["points"] if p["kind"] == "check" and p["ok"]]
+        return {"fill_settled": "", "fill_points": 0, "fill_refined": "", "fill_hbm_off": "", "fill_rest_checks": ""}
+    checks = [p for p in rec["points"] if p["kind"] == "check" and p["ok"]]
+    off = [p["hbm_off"] for p in checks if p.get("method") == "shooting"]
     return {"fill_settled": sum(p["ok"] for p in rec["points"]), "fill_points": len(rec["points"]),
-            "fill_hbm_off": f"{min(off):.2g}-{max(off):.2g}" if off else ""}
+            "fill_refined": rec.get("refined", 0),
+            "fill_hbm_off": f"{min(off):.2g}-{max(off):.2g}" if off else "",
+            "fill_rest_checks": sum(p.get("method") != "shooting" for p in checks)}
 
 
 def cases():

@@ -170,9 +170,9 @@ class FillRun:
         """Up to ``most`` more points in the untraced ``stretches`` ((a, b) Hz each), one at a
         time at the middle of the two neighbouring answers (a traced end or a converged point)
         whose first harmonics differ most, by more than ``REFINE_CHANGE`` (a traced end only
-        if estimated within that); each shot from the
-        nearest known solution, none integrated from rest.  Stops while a point's share of
-        the budget is left.  Returns the points added."""
+        if estimated within that); each shot from the nearest known solution, none integrated
+        from rest.  Stops while a point's share of the budget is left.  Returns the points
+        added."""
         added, failed = 0, set()
         while added < most and self._left() > POINT_SHARE * self.budget:
             pair = self._largest_change(stretches, failed)
