@@ -231,13 +231,15 @@ def test_a_walk_shoots_again_a_point_that_failed_once_a_nearer_start_is_found(mo
     monkeypatch.setattr(time_points, "simulate", from_rest)
     res = SimpleNamespace(freq_hz=np.array([1.0]), X=np.zeros((1, 3, 1)), basis=None)
     run = time_points.FillRun(None, res, None, None, 30.0, None, 3)
-    run.untraced([0.55, 0.7, 0.9])
+    assert run.untraced([0.55, 0.7, 0.9]) == []
     assert calls == [(0.9, "the traced point at 1 Hz"), (0.7, "the periodic solution at 0.9 Hz"),
                      (0.55, "the periodic solution at 0.9 Hz"), (0.7, "the periodic solution at 0.55 Hz")]
     assert sorted(p["freq_hz"] for p in run.points) == [0.55, 0.7, 0.9] and all(p["ok"] for p in run.points)
     calls.clear()
-    run.untraced([0.3])                     # nearest start 0.55: fails, and no other is nearer
-    assert calls == [(0.3, "the periodic solution at 0.55 Hz"), (0.3, "rest")]
+    lost = run.untraced([0.3])              # nearest start 0.55: fails, and no other is nearer
+    assert lost == [0.3] and calls == [(0.3, "the periodic solution at 0.55 Hz")]
+    run.from_rest(lost, [])                 # after every shot, checks' included
+    assert calls[-1] == (0.3, "rest") and run.points[-1]["freq_hz"] == 0.3
 
 
 def test_the_refinement_brackets_a_jump_inside_a_stretch(monkeypatch):

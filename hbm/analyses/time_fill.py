@@ -238,8 +238,8 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     if not walk and not checks:
         return None
     run = FillRun(case, res, problem, model, budget, progress, len(walk) + len(checks))
-    run.untraced(walk)
-    run.checks([(checks[k], worst[checks[k]]) for k in spread_order(len(checks))])
+    lost = run.untraced(walk)
+    run.from_rest(lost, run.checks([(checks[k], worst[checks[k]]) for k in spread_order(len(checks))]))
     refined = run.refine([s for s, fs in zip(stretches, freqs) if fs], refine_points)
     points, skipped = run.points, run.skipped
     points.sort(key=lambda p: p["freq_hz"])

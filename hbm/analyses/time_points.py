@@ -134,12 +134,12 @@ class FillRun:
         i = int(np.argmin(np.abs(self.res.freq_hz - f)))
         return self.res.X[i], f"the traced point at {self.res.freq_hz[i]:.6g} Hz"
 
-    def untraced(self, freqs: list) -> None:
+    def untraced(self, freqs: list) -> list:
         """The points ``freqs`` (Hz) of the untraced stretches, nearest the traced path first:
         each shot from the nearest known solution; one whose shot fails is shot again after
         the others from a start that is now nearer (a solution found beyond it: the walk
-        passes a jump), else integrated from rest."""
-        deferred = []
+        passes a jump).  Returns those that no shot found (for :meth:`from_rest`)."""
+        deferred, failed = [], []
         for f in sorted(freqs, key=lambda f: distance(self.res, f)):
             if self._left() <= 0:
                 self.skipped.append(f)
@@ -153,7 +153,8 @@ class FillRun:
                 continue
             X, start = self._start(f)
             if start == tried or not self._shot(f, X, start):
-                self._add(f, None)
+                failed.append(f)
+        return failed
 
     def _shot(self, f: float, X, start: str) -> bool:
         """Shoot at ``f`` from ``X`` (nothing without one); a converged shot is kept as a
@@ -213,14 +214,13 @@ class FillRun:
         errs = [o.err[i] for o in self.res.outputs.values() if getattr(o, "err", None) is not None]
         return not errs or bool(np.nan_to_num(max(errs), nan=np.inf) <= REFINE_CHANGE)
 
-    def checks(self, items: list) -> None:
+    def checks(self, items: list) -> list:
         """The checks of path points ``items`` ((i, estimate) each, in the order given): each
         shot from its traced point; those whose shots fail are shot again after the others,
         nearest first, from the nearest periodic solution found (a neighbouring check's or a
         stretch point's: a traced point estimated far off may be too far for Newton to start
-        from), else
-        integrated from rest, which may settle on another branch (``method`` "rest")."""
-        deferred = []
+        from).  Returns the items that no shot found (for :meth:`from_rest`)."""
+        deferred, failed = [], []
         for i, estimate in items:
             f = float(self.res.freq_hz[i])
             if self._left() <= 0:
@@ -243,9 +243,23 @@ class FillRun:
             g = min(self.known, key=lambda k: abs(k - f), default=None)
             shot, X_shot = (None, None) if g is None else shoot_point(
                 self.case, self.res.basis, self.known[g], f, self.problem, f"the periodic solution at {g:.6g} Hz")
+            if shot is None:
+                failed.append((i, estimate))
+                continue
             if X_shot is not None:
                 self.known[f] = X_shot
             self._add(f, shot, i, estimate)
+        return failed
+
+    def from_rest(self, freqs: list, items: list) -> None:
+        """Integrate from rest what no shot found, after every shot (each may take a quarter
+        of the budget): the untraced points ``freqs`` (Hz) first (an answer where there is
+        none), then the checks ``items`` ((i, estimate) each), which may settle on another
+        branch than the traced one (``method`` "rest": reported apart)."""
+        for f in freqs:
+            self._add(f, None)
+        for i, estimate in items:
+            self._add(float(self.res.freq_hz[i]), None, i, estimate)
 
     def _add(self, f, shot, i=None, estimate=None) -> None:
         left = self._left()                  # a shot that did not converge took its time
