@@ -264,3 +264,27 @@ def test_the_refinement_brackets_a_jump_inside_a_stretch(monkeypatch):
     run = time_points.FillRun(None, res, None, None, 30.0, None, 2)
     run.untraced([0.9, 0.95])
     assert run.refine([(0.5, 1.0)], 4) == 0
+
+
+def test_a_check_that_cannot_start_from_its_point_starts_from_a_reliable_neighbour(monkeypatch):
+    """Path points at 1.0 (estimated 1 % off) and 1.1 Hz (50 % off, checked): the shot from the
+    far-off point itself fails, no other solution is known, so the check is shot from the
+    reliable point at 1.0 Hz, not integrated from rest."""
+    from types import SimpleNamespace
+    from hbm.analyses import time_points
+    starts = []
+
+    def shoot(case, basis, X, f, problem, start):
+        starts.append(start)
+        if start == "the traced point":
+            return None, None
+        return {"freq_hz": f, "ok": True, "h1": {"x": 1.0}, "max": {"x": 1.0}, "method": "shooting",
+                "stable": True}, np.zeros((3, 1))
+    monkeypatch.setattr(time_points, "shoot_point", shoot)
+    out = SimpleNamespace(h1=np.array([1.0, 2.0]), err=np.array([0.01, 0.5]))
+    res = SimpleNamespace(freq_hz=np.array([1.0, 1.1]), X=np.zeros((2, 3, 1)), basis=None, outputs={"x": out})
+    run = time_points.FillRun(None, res, None, None, 30.0, None, 1)
+    assert run.checks([(1, 0.5)]) == []
+    assert starts == ["the traced point", "the traced point at 1 Hz"]
+    (p,) = run.points
+    assert p["kind"] == "check" and p["hbm_off"] == pytest.approx(1.0)

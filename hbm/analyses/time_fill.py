@@ -16,16 +16,18 @@ markers in ``frf.png``): they carry no harmonic coefficients.
 
 Each point is found by shooting (:func:`hbm.timedomain.floquet_check.check_point`: Newton on
 the period map, ``n`` and ``2 n`` steps per period for the error estimate), with its Floquet
-verdict: a check from the traced point itself; a point of an untraced stretch from the
-nearest solution known, a traced point or one its neighbours' shots found, walking into the
-stretch from the traced path (a shot that fails is tried again after the walk from a start
-that has become nearer, e.g. past a jump).  It converges in a few periods where a lightly
-damped rig integrated from rest takes hundreds or thousands (the UPD flanks rig: not
+verdict: a check from the traced point itself, else from the nearest solution another shot
+found or the nearest traced point estimated within 5 %; a point of an untraced stretch from
+the nearest solution known, a traced point or one its neighbours' shots found, walking into
+the stretch from the traced path (a shot that fails is tried again after the walk from a
+start that has become nearer, e.g. past a jump).  It converges in a few periods where a
+lightly damped rig integrated from rest takes hundreds or thousands (the UPD flanks rig: not
 periodic after 224 periods in 7.5 s; the undamped Jenkins oscillator at kt / k = 1e6: 5 of
 12 points settled in 30 s from rest, 11 of 12 in 12.5 s by the walk), or settles on another
-branch.  Where shooting does not converge (a non-smooth period map near a fold), the point is
-integrated from rest (:func:`hbm.timedomain.timesim.timesim`, Newmark with located switches
-and an ``n`` / ``2 n`` error estimate) for at most ``POINT_SHARE`` of the budget (:mod:`hbm.analyses.time_points`).
+branch.  What no shot finds is integrated from rest after every shot
+(:func:`hbm.timedomain.timesim.timesim`, Newmark with located switches and an ``n`` / ``2 n``
+error estimate), for at most ``POINT_SHARE`` of the budget each (:mod:`hbm.analyses.time_points`);
+a check found so is reported apart, not as the HBM's error.
 
 A stretch is ``[a, b]`` with ``a`` and ``b`` the ends of the traced spans around it (or the
 window's ends); its points sit at the window's end when the stretch reaches it, else at

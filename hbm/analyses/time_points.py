@@ -209,6 +209,12 @@ class FillRun:
                     best, pair = change, (fa, fb)
         return pair
 
+    def _nearest_reliable(self, f: float):
+        """Index of the traced point nearest to ``f`` that is estimated within
+        ``REFINE_CHANGE`` (a start closer to the true orbit than a far-off point), or None."""
+        order = np.argsort(np.abs(self.res.freq_hz - f), kind="stable")
+        return next((int(j) for j in order[:200] if self._reliable(int(j))), None)
+
     def _reliable(self, i: int) -> bool:
         """Traced point ``i`` is estimated within ``REFINE_CHANGE`` (or carries no estimate)."""
         errs = [o.err[i] for o in self.res.outputs.values() if getattr(o, "err", None) is not None]
@@ -219,7 +225,8 @@ class FillRun:
         shot from its traced point; those whose shots fail are shot again after the others,
         nearest first, from the nearest periodic solution found (a neighbouring check's or a
         stretch point's: a traced point estimated far off may be too far for Newton to start
-        from).  Returns the items that no shot found (for :meth:`from_rest`)."""
+        from), then from the nearest traced point estimated within ``REFINE_CHANGE``.  Returns
+        the items that no shot found (for :meth:`from_rest`)."""
         deferred, failed = [], []
         for i, estimate in items:
             f = float(self.res.freq_hz[i])
@@ -243,6 +250,10 @@ class FillRun:
             g = min(self.known, key=lambda k: abs(k - f), default=None)
             shot, X_shot = (None, None) if g is None else shoot_point(
                 self.case, self.res.basis, self.known[g], f, self.problem, f"the periodic solution at {g:.6g} Hz")
+            j = self._nearest_reliable(f)
+            if shot is None and j is not None:
+                shot, X_shot = shoot_point(self.case, self.res.basis, self.res.X[j], f, self.problem,
+                                           f"the traced point at {self.res.freq_hz[j]:.6g} Hz")
             if shot is None:
                 failed.append((i, estimate))
                 continue
