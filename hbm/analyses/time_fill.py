@@ -285,17 +285,21 @@ def fill_note(record: dict, harmonics) -> str:
         at = ", ".join(f"{p['freq_hz']:.6g}" for p in shaky[:3])
         note += (f" ({len(shaky)} of them found by shooting and unstable by Floquet, at {at} Hz: periodic "
                  f"solutions a motion from rest leaves)")
-    shot = [p for p in checks if p["ok"] and p.get("method") == "shooting"]
-    if shot:
-        unstable = sum(not p["stable"] for p in shot)
-        note += (f"; there the HBM's first harmonic is off by {_span([p['hbm_off'] for p in shot])} % "
-                 f"({len(shot)} shot from the traced point or a neighbouring check's solution"
+    compared = [p for p in checks if p["ok"] and p["same_branch"]]
+    if compared:
+        own = sum(p["own_start"] for p in compared)
+        unstable = sum(p.get("stable") is False for p in compared)
+        note += (f"; there the HBM's first harmonic is off by {_span([p['hbm_off'] for p in compared])} % "
+                 f"({own} shot from the traced point itself"
+                 + (f", {len(compared) - own} found from another start within the point's estimate"
+                    if own < len(compared) else "")
                  + (f", {unstable} of them unstable by Floquet" if unstable else "") + ")")
-    rest = [p for p in checks if p["ok"] and p.get("method") != "shooting"]
-    if rest:
-        note += (f"; {len(rest)} check{'s' * (len(rest) > 1)} integrated from rest, where shooting did not "
-                 f"converge, settled {_span([p['hbm_off'] for p in rest])} % away from the HBM's first "
-                 f"harmonic (a motion from rest may settle on another branch than the one traced)")
+    apart = [p for p in checks if p["ok"] and not p["same_branch"]]
+    if apart:
+        note += (f"; {len(apart)} check{'s' * (len(apart) > 1)} found from another start (a neighbouring "
+                 f"solution, or integrated from rest where no shot converged) lie "
+                 f"{_span([p['hbm_off'] for p in apart])} % from the HBM's first harmonic, beyond the "
+                 f"point's estimate: another branch, or the HBM farther off than estimated (not counted above)")
     bad = [p for p in record["points"] if not p["ok"]]
     if bad:
         note += f"; at {bad[0]['freq_hz']:.6g} Hz {bad[0]['message']}"

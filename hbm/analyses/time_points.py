@@ -91,14 +91,18 @@ def shoot_point(case, basis, X, f: float, problem, start: str):
             fine.X)
 
 
-def compare(p: dict, res, i: int, estimate: float) -> dict:
+def compare(p: dict, res, i: int, estimate: float, own_start: bool) -> dict:
     """A time-domain point at path point ``i`` (estimated ``estimate`` off), with the HBM's
-    first harmonics beside it."""
+    first harmonics beside it.  ``same_branch``: shot from the traced point itself (Newton
+    stays by the orbit it starts from), or found from another start (a neighbouring
+    solution, or from rest) within the point's own estimate; a solution found elsewhere and
+    further off may be another branch, so it is not read as the HBM's error."""
     hbm = {n: float(o.h1[i]) for n, o in res.outputs.items()}
-    p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(estimate)}
+    p = {**p, "kind": "check", "hbm_h1": hbm, "hbm_estimate": float(estimate), "own_start": bool(own_start)}
     if p["ok"]:
         p["hbm_off"] = max((abs(hbm[n] / p["h1"][n] - 1.0) for n in hbm if p["h1"][n] != 0.0),
                            default=float("nan"))
+        p["same_branch"] = bool(own_start or p["hbm_off"] <= estimate)
     return p
 
 
@@ -239,7 +243,7 @@ class FillRun:
                 continue
             if X_shot is not None:
                 self.known[f] = X_shot
-            self._add(f, shot, i, estimate)
+            self._add(f, shot, i, estimate, own_start=True)
         while deferred:             # a walk: the one nearest a solution found first
             gap = lambda item: min((abs(k - self.res.freq_hz[item[0]]) for k in self.known), default=0.0)  # noqa: E731
             i, estimate = deferred.pop(min(range(len(deferred)), key=lambda j: gap(deferred[j])))
@@ -272,7 +276,7 @@ class FillRun:
         for i, estimate in items:
             self._add(float(self.res.freq_hz[i]), None, i, estimate)
 
-    def _add(self, f, shot, i=None, estimate=None) -> None:
+    def _add(self, f, shot, i=None, estimate=None, own_start=False) -> None:
         left = self._left()                  # a shot that did not converge took its time
         share = POINT_SHARE * self.budget
         why = "a point's share of the budget" if share < left else "the budget ran out"
@@ -280,6 +284,6 @@ class FillRun:
             self.skipped.append(f)
             return
         p = {"kind": "untraced", **(shot or simulate(self.model, f, min(left, share), why))}
-        self.points.append(p if i is None else compare(p, self.res, i, estimate))
+        self.points.append(p if i is None else compare(p, self.res, i, estimate, own_start and shot is not None))
         if self.progress is not None:
             self.progress(len(self.points), self.total)
