@@ -135,6 +135,8 @@ def test_no_budget_simulates_nothing_and_says_so(stopped):
     rec = fill_untraced(case, res, budget=0.0, max_points=4)
     assert rec["points"] == [] and len(rec["skipped"]) == 4
     assert "0 of 4" in rec["note"] and "4 not simulated (budget 0 s)" in rec["note"]
+    # what was to be checked is said though nothing was simulated (it read ": 0 of 5 ...")
+    assert rec["checks"] == 1 and "1 traced point estimated over 20 % off: 0 of 4" in rec["note"]
 
 
 def test_only_points_estimated_far_off_are_checked():

@@ -220,7 +220,8 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
         ``freq_hz``, ``kind`` (``untraced`` / ``check``), ``ok``, per output ``h1`` and ``max``,
         ``error_estimate``, ``periods``, ``seconds``, ``message``; a check also ``hbm_h1``,
         ``hbm_estimate`` and ``hbm_off``, the HBM's largest relative deviation), ``skipped``
-        (frequencies not simulated for the budget), ``refined`` (points added where
+        (frequencies not simulated for the budget), ``checks`` (far-off points planned to be
+        checked), ``refined`` (points added where
         neighbouring answers differ most, :meth:`FillRun.refine`), ``seconds``, ``budget``,
         ``note``; None when there is
         nothing to simulate or the model is not simulated here (a condensed model with a
@@ -248,7 +249,7 @@ def fill_untraced(case, res, budget: float = BUDGET_SECONDS, max_points: int = M
     skipped.sort()
     record = {"stretches": [{"a_hz": a, "b_hz": b, "neighbour_errors": _neighbour_errors(res, a, b)}
                             for (a, b), fs in zip(stretches, freqs) if fs],
-              "points": points, "skipped": skipped, "refined": refined,
+              "points": points, "skipped": skipped, "refined": refined, "checks": len(checks),
               "seconds": time.perf_counter() - run.t0, "budget": budget}
     record["note"] = fill_note(record, res.settings.get("harmonics", []))
     res.settings["time_fill"] = record
@@ -268,8 +269,9 @@ def fill_note(record: dict, harmonics) -> str:
     parts = [f"{a['a_hz']:.6g}..{a['b_hz']:.6g} Hz" for a in record["stretches"]]
     checks = [p for p in record["points"] if p["kind"] == "check"]
     where = [f"untraced {', '.join(parts)}"] if parts else []
-    where += [f"{len(checks)} traced point{'s' * (len(checks) > 1)} estimated over {100 * UNRELIABLE:.0f} % "
-              f"off"] if checks else []
+    n_checks = record.get("checks", len(checks))        # planned, simulated or not
+    where += [f"{n_checks} traced point{'s' * (n_checks > 1)} estimated over {100 * UNRELIABLE:.0f} % "
+              f"off"] if n_checks else []
     note = (f"{' and '.join(where)}: {len(ok)} of {len(record['points']) + len(record['skipped'])} "
             f"time-domain points ({record['seconds']:.1f} s) in frf_timedomain.csv")
     if ok:
