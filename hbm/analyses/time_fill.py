@@ -26,8 +26,10 @@ periodic after 224 periods in 7.5 s; the undamped Jenkins oscillator at kt / k =
 12 points settled in 30 s from rest, 11 of 12 in 12.5 s by the walk), or settles on another
 branch.  What no shot finds is integrated from rest after every shot
 (:func:`hbm.timedomain.timesim.timesim`, Newmark with located switches and an ``n`` / ``2 n``
-error estimate), for at most ``POINT_SHARE`` of the budget each (:mod:`hbm.analyses.time_points`);
-a check found so is reported apart, not as the HBM's error.
+error estimate), for at most ``POINT_SHARE`` of the budget each (:mod:`hbm.analyses.time_points`).
+A check found from another start than its own point (a neighbour's solution, or from rest)
+that lands beyond the point's estimate may be on another branch: it is reported apart, not as
+the HBM's error.
 
 A stretch is ``[a, b]`` with ``a`` and ``b`` the ends of the traced spans around it (or the
 window's ends); its points sit at the window's end when the stretch reaches it, else at

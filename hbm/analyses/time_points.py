@@ -8,9 +8,13 @@ the relative difference of their first harmonics and peaks is the point's error 
 monodromy matrix's multipliers its Floquet verdict.  :class:`FillRun` runs a fill's points
 within its budget: the points of an untraced stretch walk into it from the traced path, each
 shot from the nearest solution known (a traced point, or what a neighbour's shot found); the
-checks of far-off traced points shoot from the points themselves.  A point whose shot fails is
-integrated from rest (:func:`hbm.timedomain.timesim.timesim`) for at most ``POINT_SHARE`` of
-the budget.
+checks of far-off traced points shoot from the points themselves, else from a solution found
+nearby or a traced point estimated within ``REFINE_CHANGE``.  What no shot finds is
+integrated from rest (:func:`hbm.timedomain.timesim.timesim`) after every shot, for at most
+``POINT_SHARE`` of the budget each.  A check is read as the HBM's error when it is on the
+traced branch: shot from its own point, or found elsewhere within the point's estimate
+(:func:`compare`).  Then, with budget left, :meth:`FillRun.refine` adds points where
+neighbouring answers of a stretch differ by more than ``REFINE_CHANGE``.
 """
 from __future__ import annotations
 
