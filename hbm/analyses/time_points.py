@@ -217,6 +217,10 @@ class FillRun:
                     best, pair = change, (fa, fb)
         return pair
 
+    def _to_known(self, f: float) -> float:
+        """Distance (Hz) from ``f`` to the nearest solution the shots found (0 without any)."""
+        return min((abs(g - f) for g in self.known), default=0.0)
+
     def _nearest_reliable(self, f: float):
         """Index of the traced point nearest to ``f`` that is estimated within
         ``REFINE_CHANGE`` (a start closer to the true orbit than a far-off point), or None."""
@@ -249,8 +253,8 @@ class FillRun:
                 self.known[f] = X_shot
             self._add(f, shot, i, estimate, own_start=True)
         while deferred:             # a walk: the one nearest a solution found first
-            gap = lambda item: min((abs(k - self.res.freq_hz[item[0]]) for k in self.known), default=0.0)  # noqa: E731
-            i, estimate = deferred.pop(min(range(len(deferred)), key=lambda j: gap(deferred[j])))
+            k = min(range(len(deferred)), key=lambda m: self._to_known(float(self.res.freq_hz[deferred[m][0]])))
+            i, estimate = deferred.pop(k)
             f = float(self.res.freq_hz[i])
             if self._left() <= 0:
                 self.skipped.append(f)
@@ -258,8 +262,8 @@ class FillRun:
             g = min(self.known, key=lambda k: abs(k - f), default=None)
             shot, X_shot = (None, None) if g is None else shoot_point(
                 self.case, self.res.basis, self.known[g], f, self.problem, f"the periodic solution at {g:.6g} Hz")
-            j = self._nearest_reliable(f)
-            if shot is None and j is not None:
+            j = self._nearest_reliable(f) if shot is None else None
+            if j is not None:
                 shot, X_shot = shoot_point(self.case, self.res.basis, self.res.X[j], f, self.problem,
                                            f"the traced point at {self.res.freq_hz[j]:.6g} Hz")
             if shot is None:
