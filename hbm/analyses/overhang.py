@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hbm.analyses.gap_bridge import _Marcher, march
+from hbm.analyses.gap_bridge import _Marcher, _rel, march
 from hbm.analyses.problem_setup import recover_outputs
 from hbm.analyses.gaps import jump, state_gaps
 from hbm.analyses.trace import _trace
@@ -215,18 +215,18 @@ def trace_overhangs(problem, case, pts, segments, settings, window, xscale, r_sc
     segs = [pts.part(a, b) for a, b in segments]
     gaps = list(settings.get("gaps") or [])
     folds_hz, middle, record = [], [], []
-    budget = [max(len(pts.w), MIN_POINTS)]      # points of all traces together
+    budget = max(len(pts.w), MIN_POINTS)        # points of all traces together
     for k in range(len(segs) - 2, -1, -1):      # the top first: lower indices stay
         low, high = segs[k], segs[k + 1]
         n_have = sum(len(s.w) for s in segs)
-        if _rel(low.X[-1], high.X[0]) <= MEET or n_have >= case.analysis.max_points or budget[0] <= 0:
+        if _rel(low.X[-1], high.X[0]) <= MEET or n_have >= case.analysis.max_points or budget <= 0:
             continue
         gap = next((g for g in gaps if np.isclose(g["from_hz"], low.w[-1] / (2 * np.pi), rtol=1e-12, atol=0)), None)
         ctx = (problem, case, window, xscale, r_scale, opts, lam_step,
-               min(MAX_POINTS, budget[0], case.analysis.max_points - n_have))
+               min(MAX_POINTS, budget, case.analysis.max_points - n_have))
         ends = (low.Y[-1], high.Y[0])          # where the traces start
         joined, low, high, watches, spent = _overhang(ctx, low, high)
-        budget[0] -= spent
+        budget -= spent
         sides = [w.folds > 0 for w in watches]
         folds_hz += [f for w in watches for f in w.folds_hz]
         added = sum(len(s.w) for s in ([low] if joined else [low, high])) - len(segs[k].w) - len(segs[k + 1].w)
@@ -257,11 +257,6 @@ def trace_overhangs(problem, case, pts, segments, settings, window, xscale, r_sc
             + (f"(where the first trace stopped: {middle[0]['reason']})" if middle[0]["reason"] else
                "(the two traces from its ends stopped on it)"))
     return folds_hz
-
-
-def _rel(a, b) -> float:
-    """Relative distance of two coefficient arrays."""
-    return float(np.linalg.norm(a - b) / max(np.linalg.norm(a), np.linalg.norm(b), 1e-300))
 
 
 def _narrowed(basis, gap: dict, low, high, ends, fold_low: bool, fold_high: bool) -> dict:

@@ -124,12 +124,13 @@ def _trace_frf(case, harmonics, samples, fmin, fmax, transform, progress, option
                 "transform": problem.nl.transform.name, "stability": stability,
                 **setting_sources(case, harmonics, samples, N), **info}
     shape = (basis.n_coef, problem.n_dof)
+    opts = options or ArclengthOptions()
     pts, segments, (status, message, folds, n_rej), xscale = trace_window(
-        problem, case, (w_lo, w_hi), xscale, r_scale, options or ArclengthOptions(), progress, settings)
+        problem, case, (w_lo, w_hi), xscale, r_scale, opts, progress, settings)
     bridge_gaps(problem, case, pts, segments, settings, xscale, r_scale, progress)
     if len(segments) > 1:
         folds = folds + trace_overhangs(problem, case, pts, segments, settings, (w_lo, w_hi), xscale, r_scale,
-                                        options or ArclengthOptions(), _step_limit(problem, case, (w_lo, w_hi)))
+                                        opts, _step_limit(problem, case, (w_lo, w_hi)))
     if status != "finished" or settings.get("gaps"):
         hint = stiff_contact_hint(case)
         if hint:

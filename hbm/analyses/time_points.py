@@ -134,7 +134,7 @@ class FillRun:
         """``(X, description)`` of the nearest known solution to ``f``: a traced point or a
         converged shot; ``(None, "")`` when there is neither."""
         d_path = distance(self.res, f)
-        g = min(self.known, key=lambda k: abs(k - f), default=None)
+        g = self._nearest_known(f)
         if g is not None and abs(g - f) < d_path:
             return self.known[g], f"the periodic solution at {g:.6g} Hz"
         if not np.isfinite(d_path):
@@ -217,9 +217,14 @@ class FillRun:
                     best, pair = change, (fa, fb)
         return pair
 
+    def _nearest_known(self, f: float):
+        """Frequency (Hz) of the solution the shots found nearest to ``f``, or None."""
+        return min(self.known, key=lambda g: abs(g - f), default=None)
+
     def _to_known(self, f: float) -> float:
         """Distance (Hz) from ``f`` to the nearest solution the shots found (0 without any)."""
-        return min((abs(g - f) for g in self.known), default=0.0)
+        g = self._nearest_known(f)
+        return 0.0 if g is None else abs(g - f)
 
     def _nearest_reliable(self, f: float):
         """Index of the traced point nearest to ``f`` that is estimated within
@@ -259,7 +264,7 @@ class FillRun:
             if self._left() <= 0:
                 self.skipped.append(f)
                 continue
-            g = min(self.known, key=lambda k: abs(k - f), default=None)
+            g = self._nearest_known(f)
             shot, X_shot = (None, None) if g is None else shoot_point(
                 self.case, self.res.basis, self.known[g], f, self.problem, f"the periodic solution at {g:.6g} Hz")
             j = self._nearest_reliable(f) if shot is None else None

@@ -23,8 +23,6 @@ from pathlib import Path
 import numpy as np
 
 JUMP_COLOURS = {"up": "tab:red", "down": "tab:blue"}
-
-
 LOG_AXIS_SPAN = 100.0   # a window spanning this ratio of frequencies or more is drawn on a log axis
 
 
