@@ -75,6 +75,33 @@ def test_the_branch_from_the_top_is_restarted_below_its_own_stops(monkeypatch):
     assert res.energy_error.max() < 1e-8
 
 
+def test_a_restart_on_the_upward_stop_ends_the_descent(monkeypatch):
+    """A restart below a stop of the branch from fmax may land on its limit, the upward path's
+    stop: nothing is left to trace down from it.  The descent once asked the continuation for
+    the window (w_stop, w_stop) there, which it refuses with a ValueError (seen on a stiff
+    point contact).  Traces and restarts are stand-ins here."""
+    import types
+
+    import hbm.analyses.trace as trace
+    w_stop, w_hi = 1.0, 2.0
+    calls = []
+
+    def fake_trace(problem, case, part, X, it, w0, bounds, direction, *a, **k):
+        assert bounds[0] < bounds[1], f"a window of no width: {bounds}"
+        calls.append((w0, direction))
+        end = 1.5 if direction < 0 else bounds[1]          # down: a stop at 1.5; up: finished
+        for w in (w0, end):
+            part.append(X, w, None, 0, 0.0, 0)
+        return ("failed" if direction < 0 else "finished"), "stop (test)", [], 0
+    monkeypatch.setattr(trace, "_trace", fake_trace)
+    monkeypatch.setattr(trace, "_fresh_point_past", lambda *a, limit=None, **k: ("X", 0, limit))
+    case = types.SimpleNamespace(analysis=types.SimpleNamespace(max_points=1000))
+    parts, ends, _, _ = trace._down_past_stops(None, case, ("X", 0, w_hi), w_stop, 0, (0.5, w_hi), None, 1.0,
+                                                None, None, None)
+    assert calls == [(w_hi, -1), (w_stop, +1)]     # down to the stop at 1.5, up from the restart at 1.0
+    assert [p.w for p, _ in parts] == [[w_hi, 1.5], [w_stop, 1.5]]
+
+
 # ------------------------------------------------------------------ restarts on a traced branch
 def duffing_setup():
     """The hardening Duffing of tests/test_duffing.py (three solutions between its folds), its

@@ -106,8 +106,8 @@ class _Marcher:
         got = solve_near(problem, problem.expand(guess[:-1]), w, np.inf, self.xscale, self.r_scale)
         if got is None or not np.all(np.isfinite(got[0])):
             return None
-        X, err, floor = closed_balance(problem, got[0], w, self.xscale, self.r_scale)
-        if refused(err, floor):
+        X, err, floor, res = closed_balance(problem, got[0], w, self.xscale, self.r_scale)
+        if refused(err, floor, res):
             return None
         return np.r_[problem.unknowns(X), w], got[1], err, problem.nl.last_unclosed
 

@@ -20,7 +20,7 @@ import numpy as np
 from continuation import Arclength
 
 from hbm.analyses.gaps import jump, state_gaps
-from hbm.analyses.polish import ENERGY_LIMIT, balance_resolution, closed_balance, refused
+from hbm.analyses.polish import ENERGY_LIMIT, FORCE_LIMIT, balance_resolution, closed_balance, refused
 from hbm.analyses.problem_setup import _first_point, recover_outputs
 from hbm.analyses.resonances import ResonanceStepLimit, linear_resonances
 from hbm.balance.energy import energy_balance
@@ -67,12 +67,10 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
     for pt in solver:
         X = problem.expand(pt.x[:-1])
         w = float(pt.x[-1])
-        X, err, floor = closed_balance(problem, X, w, xscale, r_scale, solver.linear_solve, scale[-1])
-        if refused(err, floor):
-            return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: the energy balance of the "
-                    f"converged point does not close (relative error {err:.1e} > {ENERGY_LIMIT:g} "
-                    f"after polishing, resolution there {floor:.1e}); the {len(pts.w)} points before it "
-                    f"are kept",
+        X, err, floor, res = closed_balance(problem, X, w, xscale, r_scale, solver.linear_solve, scale[-1])
+        if refused(err, floor, res):
+            return ("failed", f"stopped at {w / (2 * np.pi):.6g} Hz: {_unclosed(err, floor, res)}; the "
+                    f"{len(pts.w)} points before it are kept",
                     [f / (2 * np.pi) for f in solver.folds], solver.n_rejected)
         pts.append(X, w, recover_outputs(problem, case, X, w), pt.iterations if pts.w else it0 + pt.iterations,
                    err, problem.nl.last_unclosed)        # of the energy balance's force call at X
@@ -83,6 +81,15 @@ def _trace(problem, case, pts, X0, it0, w0, bounds, direction, xscale, r_scale, 
         if offset + len(pts.w) >= case.analysis.max_points:
             break
     return solver.status, solver.message, [f / (2 * np.pi) for f in solver.folds], solver.n_rejected
+
+
+def _unclosed(err: float, floor: float, res: float) -> str:
+    """Why a converged point is not reported (:func:`hbm.analyses.polish.refused`)."""
+    if err > ENERGY_LIMIT + 2 * floor:
+        return (f"the energy balance of the converged point does not close (relative error {err:.1e} > "
+                f"{ENERGY_LIMIT:g} after polishing, resolution there {floor:.1e})")
+    return (f"the residual of the converged point stays at {res:.1e} of the load after polishing "
+            f"(> {FORCE_LIMIT:g}: a stiff contact's switch Newton cannot settle)")
 
 
 GAP_FIRST = 1e-3        # first restart this share of the window past a stop, doubled per try
@@ -221,6 +228,8 @@ def _down_past_stops(problem, case, first, w_stop, offset, window, xscale, r_sca
         return part, st, msg
 
     for _ in range(MAX_GAPS):
+        if w_from <= w_stop:            # a restart on the stop itself: nothing left below it
+            break
         part, st, msg = run(X, it, w_from, (w_stop, w_from), -1)
         if not part.w:
             ends[w_from] = msg

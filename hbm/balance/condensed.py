@@ -240,6 +240,11 @@ class CondensedLinear:
         dZU = (L.hdZ @ self._complex(X.reshape(-1, self.n_dof))[:, :, None])[:, :, 0]
         dRw += self._real(dZU).reshape(-1)
 
+    def residual_forces(self, X: np.ndarray, w: float, Fn: np.ndarray) -> np.ndarray:
+        """``R = Z_c U - F_eq + F_nl`` (n_u,) without a Jacobian: the nonlinear forces ``Fn``
+        (n_coef, n_c) less the contact forces the linear part implies."""
+        return (Fn - self._real(self._implied_forces(X, self.at(w)))).reshape(-1)
+
     def modal_data(self, rows: np.ndarray) -> ModalData:
         """The kept modes and residual flexibility seen from the contact coordinates ``rows``
         (:mod:`hbm.analyses.modal_hill`)."""

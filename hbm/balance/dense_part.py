@@ -165,6 +165,13 @@ class DenseLinear:
         R[:] = (ZX - self.Fex + Fn).reshape(-1)[fi]
         dRw[:] = (dZX + dFw).reshape(-1)[fi]
 
+    def residual_forces(self, X: np.ndarray, w: float, Fn: np.ndarray) -> np.ndarray:
+        """``R = Z X - F + F_nl`` (n_u,) on the unknowns, without a Jacobian; ``Fn``
+        (n_coef, n) the nonlinear forces on every DOF."""
+        ZX, _ = self._products(X, w)
+        R = (ZX - self.Fex + Fn).reshape(-1)
+        return R if self._all_free else R[self._fi]
+
     def stuck_inverse(self, Ks: np.ndarray) -> None:
         """No approximate inverse is offered (the dense solves factor the whole Jacobian)."""
         return None

@@ -209,9 +209,18 @@ class HarmonicBalance:
 
     def energy_balance(self, X: np.ndarray, w: float) -> EnergyBalance:
         """Work per period of the excitation, the viscous and the nonlinear forces (:mod:`hbm.balance.energy`)."""
+        return self.balance_check(X, w)[0]
+
+    def balance_check(self, X: np.ndarray, w: float, residual: bool = False):
+        """:meth:`energy_balance` and, with ``residual``, ``max |R|`` at ``(X, w)`` from the
+        same nonlinear forces (no Jacobian): ``(EnergyBalance, float or None)``."""
         Fn = self.nonlinear_forces(X, w)
         w_ex, w_visc, bound = self.linear.work(X, w, Fn)
-        return EnergyBalance(w_ex, w_visc, work(self.basis, Fn, w * (self.basis.D @ X), w), bound)
+        eb = EnergyBalance(w_ex, w_visc, work(self.basis, Fn, w * (self.basis.D @ X), w), bound)
+        if not residual:
+            return eb, None
+        R = self.linear.residual_forces(X, w, Fn)
+        return eb, float(np.abs(R).max(initial=0.0))
 
     def energy_resolution(self, X: np.ndarray, w: float) -> float:
         """Energy imbalance (J per period) the linear part's own arithmetic can leave at an
