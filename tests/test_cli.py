@@ -119,3 +119,17 @@ def test_unusable_output_folder_is_refused_before_solving(tmp_path, sub):
         assert r.returncode == 2, (r.returncode, r.stderr)
         lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
         assert len(lines) == 1 and "cannot write results" in lines[0] and "Traceback" not in r.stderr
+
+
+def test_a_stopped_run_says_how_much_of_the_rest_the_time_domain_answered():
+    """A path that stops ends `hbm frf` with exit status 1 and why; when the time fill answered
+    frequencies the path did not reach, the same line says how many (the window may be whole)."""
+    from types import SimpleNamespace
+    from hbm.interface.cli import stop_line
+    pts = [{"kind": "untraced", "ok": True}, {"kind": "untraced", "ok": False},
+           {"kind": "untraced", "ok": True}, {"kind": "check", "ok": True}]
+    res = SimpleNamespace(message="stopped at 0.126 Hz: why", settings={"time_fill": {"points": pts}})
+    line = stop_line(res)
+    assert line.startswith("hbm: solver stopped: stopped at 0.126 Hz: why")
+    assert "answered 2 of the 3 frequencies" in line and "frf_timedomain.csv" in line
+    assert stop_line(SimpleNamespace(message="m", settings={})) == "hbm: solver stopped: m"

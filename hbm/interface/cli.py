@@ -188,9 +188,21 @@ def cmd_frf(args) -> int:
     print(f"  wrote {args.out}/frf.csv, frf.png, summary.json"
           + (", frf_timedomain.csv" if res.settings.get("time_fill") else ""))
     if not res.ok:
-        sys.stderr.write(f"hbm: solver stopped: {res.message}\n")
+        sys.stderr.write(stop_line(res) + "\n")
         return 1
     return 0
+
+
+def stop_line(res) -> str:
+    """The last line of an ``hbm frf`` whose solver stopped: why, and how much of what it did
+    not trace the time fill answered (the window may be complete though the path is not)."""
+    line = f"hbm: solver stopped: {res.message}"
+    untraced = [p for p in (res.settings.get("time_fill") or {}).get("points", []) if p.get("kind") == "untraced"]
+    if untraced:
+        ok = sum(bool(p.get("ok")) for p in untraced)
+        line += (f" (the time domain answered {ok} of the {len(untraced)} frequencies asked where the path "
+                 f"did not reach: frf_timedomain.csv)")
+    return line
 
 
 def _timesim_options(args):
