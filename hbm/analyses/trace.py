@@ -89,7 +89,7 @@ def _unclosed(err: float, floor: float, res: float) -> str:
         return (f"the energy balance of the converged point does not close (relative error {err:.1e} > "
                 f"{ENERGY_LIMIT:g} after polishing, resolution there {floor:.1e})")
     return (f"the residual of the converged point stays at {res:.1e} of the load after polishing "
-            f"(> {FORCE_LIMIT:g}: a stiff contact's switch Newton cannot settle)")
+            f"(> {FORCE_LIMIT:g})")
 
 
 GAP_FIRST = 1e-3        # first restart this share of the window past a stop, doubled per try
