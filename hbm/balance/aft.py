@@ -154,9 +154,7 @@ class NonlinearForces:
         unclosed = 0
         for e, G, parts in zip(self.elements, self._G, self._parts):
             if parts is not None:
-                for Gp, cols, sp in parts:
-                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw,
-                                        cols) < 0
+                unclosed += self._add_laws(parts, Xnl, w, F, J4, dFdw)
                 continue
             nl = e.n_local
             U = Xnl @ G.T
@@ -209,13 +207,19 @@ class NonlinearForces:
         dFdw = np.zeros((nc, q))
         J4 = J_out.reshape(nc, q, nc, q)             # a view (axes only split)
         J4[...] = 0.0
-        unclosed = 0
-        for parts, cols_q in zip(self._parts, columns):
-            for (Gp, _, sp), cols in zip(parts, cols_q):
-                unclosed += aft_law(sp, Gp, Xq, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw,
-                                    cols) < 0
-        self.last_unclosed = int(unclosed)
+        self.last_unclosed = int(sum(self._add_laws(parts, Xq, w, F, J4, dFdw, cols_q)
+                                     for parts, cols_q in zip(self._parts, columns)))
         return F, dFdw
+
+    def _add_laws(self, parts, X, w, F, J4=None, dFdw=None, cols_q=None) -> int:
+        """One element's law parts added into ``F`` (and, given them, ``J4`` and ``dFdw``) by
+        :func:`hbm.balance.aft_kernel.aft_law`, each reading its own columns of ``X`` or, with
+        ``cols_q``, those (:meth:`laws_columns`); returns how many left their loop open."""
+        unclosed = 0
+        for k, (Gp, cols, sp) in enumerate(parts):
+            unclosed += aft_law(sp, Gp, X, w, self._E, self._dE, self._P, self._row0, F, J4, dFdw,
+                                cols if cols_q is None else cols_q[k]) < 0
+        return unclosed
 
     def forces(self, Xnl: np.ndarray, w: float) -> np.ndarray:
         """Forces only, (n_coef, n_nl): the march runs with a single zero seed."""
@@ -224,8 +228,7 @@ class NonlinearForces:
         unclosed = 0
         for i, parts in enumerate(self._parts):
             if parts is not None:
-                for Gp, cols, sp in parts:
-                    unclosed += aft_law(sp, Gp, Xnl, w, self._E, self._dE, self._P, self._row0, F, cols=cols) < 0
+                unclosed += self._add_laws(parts, Xnl, w, F)
                 continue
             e = self.elements[i]
             exact = self._exact(e, Xnl @ self._G[i].T)
